@@ -1,0 +1,143 @@
+//! The fictitious target plane: a regular grid of flux bins plus an angular histogram.
+//!
+//! ```toml
+//! [detector]
+//! origin = [0.0, 0.0, 2.5]   # a corner of the target rectangle (mm)
+//! u = [1.0, 0.0, 0.0]        # first in-plane axis (grid x)
+//! v = [0.0, 1.0, 0.0]        # second in-plane axis (grid y); normal = u x v
+//! size_mm = [300.0, 200.0]
+//! bins = [100, 100]
+//! angular_bins = [18, 36]    # theta over [0, 90] deg from the normal, phi over [0, 360)
+//! ```
+//!
+//! A photon crossing the rectangle along the normal (from the back, towards the viewer)
+//! is detected and stops there; one crossing the other way passes through.
+
+use crate::geometry::Ray;
+use crate::tally::Grid;
+use glam::DVec3;
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+/// The target plane and its binning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetPlane {
+    /// A corner of the rectangle.
+    pub origin: DVec3,
+    /// Unit grid-x axis.
+    pub u: DVec3,
+    /// Unit grid-y axis (orthogonal to `u`).
+    pub v: DVec3,
+    /// Width and height (mm).
+    pub size: [f64; 2],
+    /// Flux bins along u and v.
+    pub bins: [usize; 2],
+    /// Angular bins: theta (0..90 deg) and phi (0..360 deg).
+    pub angular_bins: [usize; 2],
+}
+
+impl TargetPlane {
+    /// Unit normal: the direction photons are detected travelling along.
+    pub fn normal(&self) -> DVec3 {
+        self.u.cross(self.v)
+    }
+
+    /// Area of one flux bin (mm^2).
+    pub fn bin_area(&self) -> f64 {
+        (self.size[0] / self.bins[0] as f64) * (self.size[1] / self.bins[1] as f64)
+    }
+
+    /// Where `ray` crosses the rectangle forwards, nearer than `tmax`: distance and
+    /// in-plane coordinates (mm).
+    pub fn intersect(&self, ray: &Ray, tmax: f64) -> Option<(f64, [f64; 2])> {
+        let n = self.normal();
+        let denom = ray.dir.dot(n);
+        if denom <= 0.0 {
+            return None;
+        }
+        let t = (self.origin - ray.origin).dot(n) / denom;
+        if !(t > 0.0 && t < tmax) {
+            return None;
+        }
+        let r = ray.at(t) - self.origin;
+        let (a, b) = (r.dot(self.u), r.dot(self.v));
+        let inside = (0.0..self.size[0]).contains(&a) && (0.0..self.size[1]).contains(&b);
+        inside.then_some((t, [a, b]))
+    }
+
+    /// The flux bin holding in-plane coordinates `ab`.
+    pub fn flux_bin(&self, ab: [f64; 2]) -> (usize, usize) {
+        let f = |k: usize| {
+            let i = (ab[k] / self.size[k] * self.bins[k] as f64) as usize;
+            i.min(self.bins[k] - 1)
+        };
+        (f(0), f(1))
+    }
+
+    /// The (theta, phi) bin of a detected direction.
+    pub fn angular_bin(&self, dir: DVec3) -> (usize, usize) {
+        let (theta, phi) = self.angles(dir);
+        let [nt, np] = self.angular_bins;
+        let it = ((theta / FRAC_PI_2) * nt as f64) as usize;
+        let ip = ((phi / TAU) * np as f64) as usize;
+        (it.min(nt - 1), ip.min(np - 1))
+    }
+
+    /// Polar angle from the normal and azimuth from `u` towards `v` (radians).
+    pub fn angles(&self, dir: DVec3) -> (f64, f64) {
+        let theta = dir.dot(self.normal()).clamp(-1.0, 1.0).acos();
+        let phi = dir.dot(self.v).atan2(dir.dot(self.u)).rem_euclid(TAU);
+        (theta, phi)
+    }
+
+    /// Solid angle (sr) of angular bin row `it` (every phi bin in it has the same).
+    pub fn angular_bin_solid_angle(&self, it: usize) -> f64 {
+        let [nt, np] = self.angular_bins;
+        let t0 = FRAC_PI_2 * it as f64 / nt as f64;
+        let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
+        (t0.cos() - t1.cos()) * TAU / np as f64
+    }
+
+    /// Empty flux and angular grids for this detector.
+    pub fn empty_grids(&self) -> (Grid, Grid) {
+        (
+            Grid::new(self.bins[0], self.bins[1]),
+            Grid::new(self.angular_bins[0], self.angular_bins[1]),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane() -> TargetPlane {
+        TargetPlane {
+            origin: DVec3::ZERO,
+            u: DVec3::X,
+            v: DVec3::Y,
+            size: [10.0, 5.0],
+            bins: [10, 5],
+            angular_bins: [9, 12],
+        }
+    }
+
+    #[test]
+    fn detects_forward_crossings_only() {
+        let p = plane();
+        let up = Ray::new(DVec3::new(2.5, 1.5, -1.0), DVec3::Z);
+        let (t, ab) = p.intersect(&up, 10.0).unwrap();
+        assert_eq!(t, 1.0);
+        assert_eq!(p.flux_bin(ab), (2, 1));
+        let down = Ray::new(DVec3::new(2.5, 1.5, 1.0), DVec3::NEG_Z);
+        assert!(p.intersect(&down, 10.0).is_none());
+        let outside = Ray::new(DVec3::new(12.0, 1.5, -1.0), DVec3::Z);
+        assert!(p.intersect(&outside, 10.0).is_none());
+    }
+
+    #[test]
+    fn angular_solid_angles_cover_hemisphere() {
+        let p = plane();
+        let total: f64 = (0..9).map(|it| p.angular_bin_solid_angle(it) * 12.0).sum();
+        assert!((total - TAU).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,16 @@
+//! blutrace: Monte Carlo photon tracing and optimization of LCD backlight units.
+//!
+//! One module per physical concept: [`scene`] (files and validation), [`geometry`],
+//! [`accel`] (intersection backends), [`optics`] (surface models), [`sources`],
+//! [`tracer`] (the photon loop), [`detector`] and [`tally`] (what is scored),
+//! [`output`] (EXR, PNG, JSON) and [`run`] (a whole traced job with its summary).
+
+pub mod accel;
+pub mod detector;
+pub mod geometry;
+pub mod optics;
+pub mod rng;
+pub mod scene;
+pub mod sources;
+pub mod tally;
+pub mod tracer;

@@ -1,0 +1,108 @@
+//! Fresnel reflection, Snell refraction and total internal reflection.
+//!
+//! The paper's equation (3) writes R_s and R_p as ratios of sines and tangents, which is
+//! 0/0 at normal incidence. Here they are written with cosines (Born & Wolf), exact at
+//! every angle: normal, grazing and either side of the critical angle.
+
+use glam::DVec3;
+
+/// Unpolarized Fresnel reflectance `(R_s + R_p) / 2` for light going from index `n1`
+/// into index `n2`, with `cos_i` the cosine of the incidence angle (in `[0, 1]`).
+/// Returns 1 beyond the critical angle (total internal reflection).
+pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    match cos_transmitted(cos_i, n1, n2) {
+        None => 1.0,
+        Some(cos_t) => {
+            let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
+            let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
+            // At grazing incidence with n1 == n2 both ratios are 0/0: no interface.
+            if n1 == n2 {
+                0.0
+            } else {
+                0.5 * (rs * rs + rp * rp)
+            }
+        }
+    }
+}
+
+/// Cosine of the refraction angle by Snell's law, or `None` under total internal reflection.
+pub fn cos_transmitted(cos_i: f64, n1: f64, n2: f64) -> Option<f64> {
+    let eta = n1 / n2;
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    (sin2_t < 1.0).then(|| (1.0 - sin2_t).sqrt())
+}
+
+/// The critical angle (radians) going from `n1` into `n2 < n1`; `None` when `n2 >= n1`.
+pub fn critical_angle(n1: f64, n2: f64) -> Option<f64> {
+    (n2 < n1).then(|| (n2 / n1).asin())
+}
+
+/// Mirror reflection of `dir` about the unit normal `n` (either orientation).
+pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
+    dir - 2.0 * dir.dot(n) * n
+}
+
+/// Refracted direction of unit `dir` through a surface with unit normal `n` facing the
+/// incident side (`dir · n < 0`), from `n1` into `n2`; `None` under total internal reflection.
+pub fn refract(dir: DVec3, n: DVec3, n1: f64, n2: f64) -> Option<DVec3> {
+    let cos_i = -dir.dot(n);
+    let cos_t = cos_transmitted(cos_i, n1, n2)?;
+    let eta = n1 / n2;
+    Some((eta * dir + (eta * cos_i - cos_t) * n).normalize())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    const PMMA: f64 = 1.49;
+
+    #[test]
+    fn normal_incidence_matches_closed_form() {
+        let r0 = ((PMMA - 1.0) / (PMMA + 1.0)).powi(2);
+        assert!((reflectance(1.0, 1.0, PMMA) - r0).abs() < 1e-15);
+        assert!((reflectance(1.0, PMMA, 1.0) - r0).abs() < 1e-15);
+        assert!((r0 - 0.0387).abs() < 5e-5, "R0 = {r0}");
+    }
+
+    #[test]
+    fn grazing_incidence_reflects_everything() {
+        assert!((reflectance(0.0, 1.0, PMMA) - 1.0).abs() < 1e-12);
+        assert!(reflectance(1e-6, 1.0, PMMA) > 0.99);
+    }
+
+    #[test]
+    fn critical_angle_of_pmma() {
+        let c = critical_angle(PMMA, 1.0).unwrap().to_degrees();
+        assert!((c - 42.16).abs() < 0.01, "critical angle {c}");
+        let theta = critical_angle(PMMA, 1.0).unwrap();
+        assert_eq!(reflectance((theta + 1e-6).cos(), PMMA, 1.0), 1.0);
+        let below = reflectance((theta - 1e-6).cos(), PMMA, 1.0);
+        assert!(below < 1.0 && below > 0.9, "just below critical: {below}");
+    }
+
+    #[test]
+    fn no_interface_when_indices_match() {
+        for k in 0..=100 {
+            let cos_i = k as f64 / 100.0;
+            assert_eq!(reflectance(cos_i, 1.3, 1.3), 0.0);
+        }
+    }
+
+    #[test]
+    fn snell_law_holds() {
+        let theta_i = 30f64.to_radians();
+        let dir = DVec3::new(theta_i.sin(), 0.0, -theta_i.cos());
+        let t = refract(dir, DVec3::Z, 1.0, PMMA).unwrap();
+        let sin_t = (t.x * t.x + t.y * t.y).sqrt();
+        assert!((theta_i.sin() - PMMA * sin_t).abs() < 1e-14);
+        assert!(t.z < 0.0 && (t.length() - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn total_internal_reflection_has_no_refracted_ray() {
+        let theta_i = 50f64.to_radians();
+        let dir = DVec3::new(theta_i.sin(), 0.0, theta_i.cos());
+        assert!(refract(dir, DVec3::NEG_Z, PMMA, 1.0).is_none());
+    }
+}

@@ -1,0 +1,234 @@
+//! The optical model of each tagged surface and its Russian roulette.
+//!
+//! ```toml
+//! [media.pmma]
+//! n = 1.49
+//! absorption_per_mm = 0.0002   # Beer-Lambert coefficient (natural log), 0 = lossless
+//!
+//! [surfaces.lgp]               # a tag used by the geometry files
+//! model = "dielectric"         # Fresnel/Snell/TIR between `inside` and `outside`
+//! inside = "pmma"              # medium the face normal points away from
+//! outside = "air"              # default "air" (n = 1)
+//!
+//! [surfaces.lamp_reflector]
+//! model = "phong"              # reflectance, specular fraction, cos^exponent lobe
+//! reflectance = 0.95
+//! specular = 0.8
+//! exponent = 100.0
+//!
+//! [surfaces.ink_sheet]
+//! model = "lambert"
+//! albedo = 0.9
+//!
+//! [surfaces.silver]
+//! model = "mirror"
+//! reflectance = 0.97
+//!
+//! [surfaces.housing]
+//! model = "absorber"
+//! ```
+//!
+//! Opaque models (phong, lambert, mirror, absorber, dot ink) reflect back to the side
+//! the photon came from; a dielectric sends it to the other side's medium.
+
+use super::dots::DotPattern;
+use super::{fresnel, sampling};
+use crate::geometry::SurfaceHit;
+use crate::rng::PhotonRng;
+use glam::DVec3;
+
+/// Index of a medium in the scene's medium table (0 is the ambient medium, air).
+pub type MediumId = u16;
+
+/// A homogeneous optical medium.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Medium {
+    /// Name from the scene file.
+    pub name: String,
+    /// Refractive index.
+    pub n: f64,
+    /// Beer-Lambert absorption coefficient (1/mm).
+    pub absorption_per_mm: f64,
+}
+
+/// The two media either side of a dielectric face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interface {
+    /// The medium behind the face (the normal points away from it).
+    pub inside: MediumId,
+    /// The medium in front of the face.
+    pub outside: MediumId,
+}
+
+/// A Phong reflector (lamp reflector, reflector sheet).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phong {
+    /// Total reflectance (diffuse + specular).
+    pub reflectance: f64,
+    /// Fraction of the reflected energy in the specular lobe.
+    pub specular: f64,
+    /// Phong exponent of the specular lobe.
+    pub exponent: f64,
+}
+
+/// The optical model of one tag.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceModel {
+    /// Smooth dielectric interface.
+    Dielectric(Interface),
+    /// Dielectric interface with printed Lambertian ink dots.
+    Dots {
+        /// The interface outside the dots.
+        interface: Interface,
+        /// The dot layout.
+        pattern: DotPattern,
+        /// Albedo of the ink (the rest is absorbed).
+        ink_albedo: f64,
+    },
+    /// Phong reflector.
+    Phong(Phong),
+    /// Lambertian scatterer.
+    Lambert {
+        /// Diffuse reflectance.
+        albedo: f64,
+    },
+    /// Specular mirror.
+    Mirror {
+        /// Reflectance.
+        reflectance: f64,
+    },
+    /// Black absorber.
+    Absorber,
+}
+
+/// What a surface did to a photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Outcome {
+    /// The photon leaves in `dir`, now travelling in `medium`.
+    Scattered {
+        /// New unit direction.
+        dir: DVec3,
+        /// Medium the photon now travels in.
+        medium: MediumId,
+    },
+    /// The photon was absorbed by this surface.
+    Absorbed,
+}
+
+impl SurfaceModel {
+    /// Roulette the fate of a photon arriving along `dir` in `medium` at `hit`.
+    pub fn interact(
+        &self,
+        media: &[Medium],
+        hit: &SurfaceHit,
+        dir: DVec3,
+        medium: MediumId,
+        rng: &mut PhotonRng,
+    ) -> Outcome {
+        // Normal on the side the photon came from.
+        let facing = if dir.dot(hit.normal) < 0.0 {
+            hit.normal
+        } else {
+            -hit.normal
+        };
+        let stay = |d: DVec3| Outcome::Scattered { dir: d, medium };
+        match self {
+            SurfaceModel::Dielectric(i) => dielectric(media, i, hit.normal, dir, rng),
+            SurfaceModel::Dots {
+                interface,
+                pattern,
+                ink_albedo,
+            } => {
+                if pattern.covers(hit.point) {
+                    diffuse(*ink_albedo, facing, rng).map_or(Outcome::Absorbed, stay)
+                } else {
+                    dielectric(media, interface, hit.normal, dir, rng)
+                }
+            }
+            SurfaceModel::Phong(p) => phong(p, facing, dir, rng).map_or(Outcome::Absorbed, stay),
+            SurfaceModel::Lambert { albedo } => {
+                diffuse(*albedo, facing, rng).map_or(Outcome::Absorbed, stay)
+            }
+            SurfaceModel::Mirror { reflectance } => {
+                if rng.uniform() < *reflectance {
+                    stay(fresnel::reflect(dir, facing))
+                } else {
+                    Outcome::Absorbed
+                }
+            }
+            SurfaceModel::Absorber => Outcome::Absorbed,
+        }
+    }
+
+    /// Short model name for reports.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SurfaceModel::Dielectric(_) => "dielectric",
+            SurfaceModel::Dots { .. } => "dots",
+            SurfaceModel::Phong(_) => "phong",
+            SurfaceModel::Lambert { .. } => "lambert",
+            SurfaceModel::Mirror { .. } => "mirror",
+            SurfaceModel::Absorber => "absorber",
+        }
+    }
+
+    /// The interface of a dielectric-like model.
+    pub fn interface(&self) -> Option<Interface> {
+        match self {
+            SurfaceModel::Dielectric(i) | SurfaceModel::Dots { interface: i, .. } => Some(*i),
+            _ => None,
+        }
+    }
+}
+
+/// Fresnel roulette at a smooth interface with outward unit `normal`.
+fn dielectric(
+    media: &[Medium],
+    iface: &Interface,
+    normal: DVec3,
+    dir: DVec3,
+    rng: &mut PhotonRng,
+) -> Outcome {
+    let entering = dir.dot(normal) < 0.0;
+    let (from, to, facing) = if entering {
+        (iface.outside, iface.inside, normal)
+    } else {
+        (iface.inside, iface.outside, -normal)
+    };
+    let (n1, n2) = (media[from as usize].n, media[to as usize].n);
+    let cos_i = -dir.dot(facing);
+    let r = fresnel::reflectance(cos_i, n1, n2);
+    if r >= 1.0 || rng.uniform() < r {
+        return Outcome::Scattered {
+            dir: fresnel::reflect(dir, facing),
+            medium: from,
+        };
+    }
+    match fresnel::refract(dir, facing, n1, n2) {
+        Some(t) => Outcome::Scattered { dir: t, medium: to },
+        None => Outcome::Scattered {
+            dir: fresnel::reflect(dir, facing),
+            medium: from,
+        },
+    }
+}
+
+/// Lambertian reflection with probability `albedo` into the hemisphere of `facing`.
+fn diffuse(albedo: f64, facing: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
+    (rng.uniform() < albedo).then(|| sampling::lambertian(facing, rng.uniform(), rng.uniform()))
+}
+
+/// Phong roulette: absorbed, diffuse, or a direction in the specular lobe. A lobe
+/// direction below the surface carries no BRDF value: the photon is absorbed there.
+fn phong(p: &Phong, facing: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
+    let u = rng.uniform();
+    if u >= p.reflectance {
+        return None;
+    }
+    if u >= p.reflectance * p.specular {
+        return Some(sampling::lambertian(facing, rng.uniform(), rng.uniform()));
+    }
+    let mirror = fresnel::reflect(dir, facing);
+    let out = sampling::cos_power(mirror, p.exponent, rng.uniform(), rng.uniform());
+    (out.dot(facing) > 0.0).then_some(out)
+}

@@ -1,0 +1,281 @@
+//! The typed, versioned scene file (TOML, millimetres). Unknown keys are errors.
+//!
+//! ```toml
+//! version = 1
+//! name = "notebook14"
+//!
+//! [[geometry]]
+//! file = "notebook14.obj"    # OBJ (usemtl names, else group/object names, are tags)
+//! scale = 1.0                # optional, applied before translate
+//! translate = [0.0, 0.0, 0.0]
+//!
+//! [media.pmma]
+//! n = 1.49
+//! absorption_per_mm = 0.0
+//!
+//! [surfaces.lgp]
+//! model = "dielectric"
+//! inside = "pmma"
+//!
+//! [[sources]]
+//! type = "ccfl"
+//! center = [-3.0, 100.0, 1.5]
+//! axis = [0.0, 1.0, 0.0]
+//! radius_mm = 1.0
+//! length_mm = 200.0
+//! power_w = 1.0
+//!
+//! [detector]
+//! origin = [0.0, 0.0, 3.5]
+//! u = [1.0, 0.0, 0.0]
+//! v = [0.0, 1.0, 0.0]
+//! size_mm = [300.0, 200.0]
+//! ```
+//!
+//! Sections `[surfaces.*]`, `[[sources]]`, `[detector]` and `[trace]` are documented in
+//! the modules that implement them.
+
+use crate::optics::dots::{Lattice, XUnit};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// The only scene-file version this build reads.
+pub const SCENE_VERSION: u32 = 1;
+
+/// A whole scene file.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Format version; must be [`SCENE_VERSION`].
+    pub version: u32,
+    /// Scene name for reports (defaults to the file's folder name).
+    pub name: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+    /// Geometry files, relative to the scene file.
+    pub geometry: Vec<GeometrySpec>,
+    /// Named media (`air` exists unless redefined).
+    #[serde(default)]
+    pub media: BTreeMap<String, MediumSpec>,
+    /// Optical model per material tag.
+    pub surfaces: BTreeMap<String, SurfaceSpec>,
+    /// Light sources.
+    pub sources: Vec<SourceSpec>,
+    /// The target plane.
+    pub detector: DetectorSpec,
+    /// Tracing defaults.
+    #[serde(default)]
+    pub trace: TraceSpec,
+}
+
+/// One geometry file and its placement.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeometrySpec {
+    /// Path to an `.obj`, `.gltf` or `.glb` file.
+    pub file: PathBuf,
+    /// Uniform scale to millimetres.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Translation (mm), applied after scaling.
+    #[serde(default)]
+    pub translate: [f64; 3],
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A homogeneous medium.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumSpec {
+    /// Refractive index.
+    pub n: f64,
+    /// Beer-Lambert absorption coefficient (1/mm).
+    #[serde(default)]
+    pub absorption_per_mm: f64,
+}
+
+fn air() -> String {
+    "air".into()
+}
+
+/// The optical model of one tag.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "model", rename_all = "lowercase", deny_unknown_fields)]
+pub enum SurfaceSpec {
+    /// Smooth dielectric interface.
+    Dielectric {
+        /// Medium behind the face.
+        inside: String,
+        /// Medium in front of the face.
+        #[serde(default = "air")]
+        outside: String,
+    },
+    /// Dielectric interface with printed ink dots.
+    Dots {
+        /// Medium behind the face.
+        inside: String,
+        /// Medium in front of the face.
+        #[serde(default = "air")]
+        outside: String,
+        /// Ink albedo (Lambertian).
+        ink_albedo: f64,
+        /// Cell lattice.
+        lattice: Lattice,
+        /// Cell pitch (mm).
+        pitch_mm: f64,
+        /// A point on the lamp edge, in the face.
+        origin: [f64; 3],
+        /// Propagation direction.
+        axis: [f64; 3],
+        /// In-face direction across `axis` (default: face normal x axis, found at load).
+        across: Option<[f64; 3]>,
+        /// Span along `axis` (mm).
+        length_mm: f64,
+        /// Density polynomial coefficients, lowest degree first.
+        density: Vec<f64>,
+        /// Unit of the polynomial variable.
+        #[serde(default)]
+        x_unit: XUnit,
+        /// Lamps on both edges: measure from the nearer.
+        #[serde(default)]
+        mirror: bool,
+    },
+    /// Phong reflector.
+    Phong {
+        /// Total reflectance.
+        reflectance: f64,
+        /// Specular fraction of the reflected energy.
+        specular: f64,
+        /// Phong exponent.
+        exponent: f64,
+    },
+    /// Lambertian scatterer.
+    Lambert {
+        /// Albedo.
+        albedo: f64,
+    },
+    /// Specular mirror.
+    Mirror {
+        /// Reflectance.
+        #[serde(default = "one")]
+        reflectance: f64,
+    },
+    /// Black absorber.
+    Absorber {},
+}
+
+/// A light source.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum SourceSpec {
+    /// Cold-cathode fluorescent lamp: a Lambertian cylinder.
+    Ccfl {
+        /// Name for reports.
+        name: Option<String>,
+        /// Centre of the tube.
+        center: [f64; 3],
+        /// Tube axis.
+        axis: [f64; 3],
+        /// Radius (mm).
+        radius_mm: f64,
+        /// Length (mm).
+        length_mm: f64,
+        /// Radiant power (W).
+        power_w: f64,
+        /// Medium around the tube.
+        #[serde(default = "air")]
+        medium: String,
+    },
+    /// Flat LED emitter.
+    Led {
+        /// Name for reports.
+        name: Option<String>,
+        /// Centre of the emitting rectangle.
+        center: [f64; 3],
+        /// Emitting normal.
+        normal: [f64; 3],
+        /// Width direction.
+        u: [f64; 3],
+        /// Width (mm).
+        width_mm: f64,
+        /// Height (mm).
+        height_mm: f64,
+        /// Radiant power (W).
+        power_w: f64,
+        /// cos^m exponent (1 = Lambertian).
+        #[serde(default = "one")]
+        cos_exponent: f64,
+        /// Medium in front of the emitter.
+        #[serde(default = "air")]
+        medium: String,
+    },
+}
+
+/// The target plane.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DetectorSpec {
+    /// A corner of the rectangle.
+    pub origin: [f64; 3],
+    /// Grid-x axis.
+    pub u: [f64; 3],
+    /// Grid-y axis.
+    pub v: [f64; 3],
+    /// Width and height (mm).
+    pub size_mm: [f64; 2],
+    /// Flux bins.
+    #[serde(default = "default_bins")]
+    pub bins: [usize; 2],
+    /// Angular bins (theta, phi).
+    #[serde(default = "default_angular_bins")]
+    pub angular_bins: [usize; 2],
+}
+
+fn default_bins() -> [usize; 2] {
+    [100, 100]
+}
+
+fn default_angular_bins() -> [usize; 2] {
+    [18, 36]
+}
+
+/// Tracing defaults.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TraceSpec {
+    /// Default photon count.
+    #[serde(default = "default_photons")]
+    pub photons: u64,
+    /// Default seed.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Surface events before a photon is killed.
+    #[serde(default = "default_max_bounces")]
+    pub max_bounces: u32,
+}
+
+impl Default for TraceSpec {
+    fn default() -> Self {
+        Self {
+            photons: default_photons(),
+            seed: default_seed(),
+            max_bounces: default_max_bounces(),
+        }
+    }
+}
+
+fn default_photons() -> u64 {
+    400_000
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+fn default_max_bounces() -> u32 {
+    100_000
+}

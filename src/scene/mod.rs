@@ -1,0 +1,574 @@
+//! Scene loading: the scene file, its geometry files, and validation into a traceable
+//! [`Scene`]. Every error names the file and the field.
+//!
+//! See [`config`] for the file format. Loading also:
+//! - drops zero-area triangles (with a warning);
+//! - checks that every dielectric medium is bounded by a closed surface and orients its
+//!   faces outward (re-winding inconsistent CAD exports, with a warning);
+//! - moves the scene's centre to the origin, so f32 backends keep their precision far
+//!   from the file's origin (outputs are in detector coordinates, so nothing changes).
+
+pub mod config;
+pub mod meshio;
+mod solids;
+
+use crate::detector::TargetPlane;
+use crate::geometry::{Aabb, Mesh};
+use crate::optics::dots::DotPattern;
+use crate::optics::surface::{Interface, Medium, MediumId, Phong, SurfaceModel};
+use crate::rng::PhotonRng;
+use crate::sources::{Emitter, Source, Sources};
+use anyhow::{Context, Result};
+use config::{DetectorSpec, SceneFile, SourceSpec, SurfaceSpec};
+use glam::{DMat4, DVec3};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A validated, traceable scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Scene name.
+    pub name: String,
+    /// The scene file.
+    pub path: PathBuf,
+    /// All triangles, each with a tag index.
+    pub mesh: Arc<Mesh>,
+    /// Tag names, indexed by the mesh's tag indices.
+    pub tags: Vec<String>,
+    /// Optical model per tag.
+    pub surfaces: Vec<SurfaceModel>,
+    /// Media; index 0 is the ambient medium (air).
+    pub media: Vec<Medium>,
+    /// Light sources.
+    pub sources: Sources,
+    /// Target plane.
+    pub detector: TargetPlane,
+    /// Bounce cap per photon.
+    pub max_bounces: u32,
+    /// Default photon count.
+    pub default_photons: u64,
+    /// Default seed.
+    pub default_seed: u64,
+    /// Offset by which the file's coordinates were moved (file = scene + offset).
+    pub offset: DVec3,
+    /// Distance (mm) by which a scattered ray starts off its surface.
+    pub spawn_eps: f64,
+    /// Non-fatal findings of loading, for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Names an error's place: file and field.
+struct Ctx<'a>(&'a Path);
+
+impl Ctx<'_> {
+    fn err(&self, field: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+        anyhow::anyhow!("{}: {field}: {msg}", self.0.display())
+    }
+
+    fn finite(&self, field: &str, x: f64) -> Result<f64> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    fn positive(&self, field: &str, x: f64) -> Result<f64> {
+        if self.finite(field, x)? > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be > 0, got {x}")))
+        }
+    }
+
+    fn fraction(&self, field: &str, x: f64) -> Result<f64> {
+        if (0.0..=1.0).contains(&self.finite(field, x)?) {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be within [0, 1], got {x}")))
+        }
+    }
+
+    fn point(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
+        for (i, c) in p.iter().enumerate() {
+            self.finite(&format!("{field}[{i}]"), *c)?;
+        }
+        Ok(DVec3::from_array(p))
+    }
+
+    fn direction(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
+        let v = self.point(field, p)?;
+        if v.length() < 1e-12 {
+            return Err(self.err(field, "must be a non-zero direction"));
+        }
+        Ok(v.normalize())
+    }
+}
+
+impl Scene {
+    /// Load and validate the scene file at `path` and the geometry it names.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{}: cannot read scene file", path.display()))?;
+        let file: SceneFile =
+            toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        Self::from_file(&file, path)
+    }
+
+    /// Build a scene from an already parsed scene file; geometry paths are relative to
+    /// `path`'s folder.
+    pub fn from_file(file: &SceneFile, path: &Path) -> Result<Scene> {
+        let ctx = Ctx(path);
+        if file.version != config::SCENE_VERSION {
+            return Err(ctx.err(
+                "version",
+                format!(
+                    "this blutrace reads version {}, the file says {}",
+                    config::SCENE_VERSION,
+                    file.version
+                ),
+            ));
+        }
+        let mut warnings = Vec::new();
+        let media = build_media(&ctx, &file.media)?;
+        let (mut mesh, tags) = load_geometry(&ctx, file, path, &mut warnings)?;
+        let mut surfaces = Vec::with_capacity(tags.len());
+        for tag in &tags {
+            let spec = file
+                .surfaces
+                .get(tag)
+                .expect("tags are checked against surfaces");
+            surfaces.push(build_surface(&ctx, tag, spec, &media)?);
+        }
+        for unused in file.surfaces.keys().filter(|k| !tags.contains(k)) {
+            warnings.push(format!(
+                "[surfaces.{unused}] is not used by any geometry file"
+            ));
+        }
+        solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
+        finish_dot_patterns(&ctx, &mesh, &tags, &mut surfaces)?;
+        let sources = build_sources(&ctx, &file.sources, &media)?;
+        let detector = build_detector(&ctx, &file.detector)?;
+        if file.trace.max_bounces == 0 {
+            return Err(ctx.err("trace.max_bounces", "must be at least 1"));
+        }
+        let name = file.name.clone().unwrap_or_else(|| default_name(path));
+        let mut scene = Scene {
+            name,
+            path: path.to_path_buf(),
+            mesh: Arc::new(mesh),
+            tags,
+            surfaces,
+            media,
+            sources,
+            detector,
+            max_bounces: file.trace.max_bounces,
+            default_photons: file.trace.photons,
+            default_seed: file.trace.seed,
+            offset: DVec3::ZERO,
+            spawn_eps: 0.0,
+            warnings,
+        };
+        scene.recenter();
+        Ok(scene)
+    }
+
+    /// Move the scene so its bounding box is centred on the origin and set the spawn
+    /// offset for the new extent.
+    fn recenter(&mut self) {
+        let mut b = self.mesh.bounds();
+        for s in &self.sources.list {
+            b.grow(s.anchor());
+        }
+        b.grow(self.detector.origin);
+        let c = if b.is_empty() {
+            DVec3::ZERO
+        } else {
+            0.5 * (b.min + b.max)
+        };
+        let mesh = Arc::make_mut(&mut self.mesh);
+        mesh.positions.iter_mut().for_each(|p| *p -= c);
+        self.sources.translate(-c);
+        self.detector.origin -= c;
+        for s in &mut self.surfaces {
+            if let SurfaceModel::Dots { pattern, .. } = s {
+                pattern.origin -= c;
+            }
+        }
+        self.offset += c;
+        let extent = Aabb {
+            min: b.min - c,
+            max: b.max - c,
+        }
+        .max_abs_coordinate();
+        self.spawn_eps = spawn_epsilon(extent);
+    }
+
+    /// The start of a ray leaving a surface at `point` (unit `normal`) along `dir`:
+    /// nudged off the surface to the side `dir` goes. One rule for all backends.
+    pub fn spawn_point(&self, point: DVec3, normal: DVec3, dir: DVec3) -> DVec3 {
+        point + normal * self.spawn_eps.copysign(dir.dot(normal))
+    }
+
+    /// A Beer-Lambert free path (mm) in `medium`; infinite in a lossless medium.
+    pub fn free_path(&self, medium: MediumId, rng: &mut PhotonRng) -> f64 {
+        let a = self.media[medium as usize].absorption_per_mm;
+        if a > 0.0 {
+            -(1.0 - rng.uniform()).ln() / a
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Number of triangles per tag.
+    pub fn triangles_per_tag(&self) -> Vec<usize> {
+        let mut n = vec![0; self.tags.len()];
+        self.mesh.tri_tag.iter().for_each(|&t| n[t as usize] += 1);
+        n
+    }
+}
+
+/// The spawn offset for a scene whose coordinates reach `extent` mm: a few f32 ulps
+/// there, so single-precision backends never re-hit the surface a ray leaves.
+pub fn spawn_epsilon(extent: f64) -> f64 {
+    16.0 * f32::EPSILON as f64 * extent.max(1.0)
+}
+
+fn default_name(path: &Path) -> String {
+    path.parent()
+        .and_then(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into())
+}
+
+fn build_media(ctx: &Ctx, specs: &BTreeMap<String, config::MediumSpec>) -> Result<Vec<Medium>> {
+    let mut media = vec![Medium {
+        name: "air".into(),
+        n: 1.0,
+        absorption_per_mm: 0.0,
+    }];
+    for (name, spec) in specs {
+        let n = ctx.positive(&format!("media.{name}.n"), spec.n)?;
+        let a = ctx.finite(
+            &format!("media.{name}.absorption_per_mm"),
+            spec.absorption_per_mm,
+        )?;
+        if a < 0.0 {
+            return Err(ctx.err(
+                &format!("media.{name}.absorption_per_mm"),
+                format!("must be >= 0, got {a}"),
+            ));
+        }
+        let m = Medium {
+            name: name.clone(),
+            n,
+            absorption_per_mm: a,
+        };
+        if name == "air" {
+            media[0] = m;
+        } else {
+            media.push(m);
+        }
+    }
+    if media.len() > MediumId::MAX as usize {
+        return Err(ctx.err("media", "too many media"));
+    }
+    Ok(media)
+}
+
+fn medium_id(ctx: &Ctx, field: &str, name: &str, media: &[Medium]) -> Result<MediumId> {
+    media
+        .iter()
+        .position(|m| m.name == name)
+        .map(|i| i as MediumId)
+        .ok_or_else(|| {
+            let known: Vec<&str> = media.iter().map(|m| m.name.as_str()).collect();
+            ctx.err(
+                field,
+                format!("unknown medium '{name}' (known: {})", known.join(", ")),
+            )
+        })
+}
+
+fn load_geometry(
+    ctx: &Ctx,
+    file: &SceneFile,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<(Mesh, Vec<String>)> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut tags: Vec<String> = Vec::new();
+    let mut mesh = Mesh::default();
+    for (i, g) in file.geometry.iter().enumerate() {
+        let scale = ctx.positive(&format!("geometry[{i}].scale"), g.scale)?;
+        let shift = ctx.point(&format!("geometry[{i}].translate"), g.translate)?;
+        let transform = DMat4::from_translation(shift) * DMat4::from_scale(DVec3::splat(scale));
+        let gpath = dir.join(&g.file);
+        if !gpath.exists() {
+            return Err(ctx.err(
+                &format!("geometry[{i}].file"),
+                format!("{} does not exist", gpath.display()),
+            ));
+        }
+        let tris = meshio::load(&gpath, transform)?;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(&tris.positions);
+        let mut dropped = 0;
+        for (t, tag) in tris.triangles.iter().zip(&tris.tags) {
+            if !file.surfaces.contains_key(tag) {
+                return Err(ctx.err(
+                    "surfaces",
+                    format!(
+                        "{} uses tag '{tag}', but the scene has no [surfaces.{tag}]",
+                        gpath.display()
+                    ),
+                ));
+            }
+            let tri = t.map(|v| v + base);
+            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+            if (b - a).cross(c - a).length_squared() == 0.0 {
+                dropped += 1;
+                continue;
+            }
+            let id = match tags.iter().position(|x| x == tag) {
+                Some(p) => p,
+                None => {
+                    tags.push(tag.clone());
+                    tags.len() - 1
+                }
+            };
+            mesh.triangles.push(tri);
+            mesh.tri_tag.push(id as u32);
+        }
+        if dropped > 0 {
+            warnings.push(format!(
+                "{}: dropped {dropped} zero-area triangle(s)",
+                gpath.display()
+            ));
+        }
+    }
+    Ok((mesh, tags))
+}
+
+fn interface(
+    ctx: &Ctx,
+    tag: &str,
+    inside: &str,
+    outside: &str,
+    media: &[Medium],
+) -> Result<Interface> {
+    Ok(Interface {
+        inside: medium_id(ctx, &format!("surfaces.{tag}.inside"), inside, media)?,
+        outside: medium_id(ctx, &format!("surfaces.{tag}.outside"), outside, media)?,
+    })
+}
+
+fn build_surface(
+    ctx: &Ctx,
+    tag: &str,
+    spec: &SurfaceSpec,
+    media: &[Medium],
+) -> Result<SurfaceModel> {
+    let f = |k: &str| format!("surfaces.{tag}.{k}");
+    Ok(match spec {
+        SurfaceSpec::Dielectric { inside, outside } => {
+            SurfaceModel::Dielectric(interface(ctx, tag, inside, outside, media)?)
+        }
+        SurfaceSpec::Dots {
+            inside,
+            outside,
+            ink_albedo,
+            lattice,
+            pitch_mm,
+            origin,
+            axis,
+            across,
+            length_mm,
+            density,
+            x_unit,
+            mirror,
+        } => {
+            if density.is_empty() {
+                return Err(ctx.err(&f("density"), "needs at least one coefficient"));
+            }
+            for (i, c) in density.iter().enumerate() {
+                ctx.finite(&format!("{}[{i}]", f("density")), *c)?;
+            }
+            let pattern = DotPattern {
+                lattice: *lattice,
+                pitch: ctx.positive(&f("pitch_mm"), *pitch_mm)?,
+                origin: ctx.point(&f("origin"), *origin)?,
+                axis: ctx.direction(&f("axis"), *axis)?,
+                across: match across {
+                    Some(a) => ctx.direction(&f("across"), *a)?,
+                    None => DVec3::ZERO,
+                },
+                length: ctx.positive(&f("length_mm"), *length_mm)?,
+                density: density.clone(),
+                x_unit: *x_unit,
+                mirror: *mirror,
+            };
+            if let Some((u, d)) = pattern.first_out_of_range() {
+                return Err(ctx.err(&f("density"), format!(
+                    "d(x) = {d:.4} at {u:.3} mm from the origin is outside [0, {:.4}] (the {:?} lattice's packing limit)",
+                    lattice.max_packing(), lattice
+                )));
+            }
+            SurfaceModel::Dots {
+                interface: interface(ctx, tag, inside, outside, media)?,
+                pattern,
+                ink_albedo: ctx.fraction(&f("ink_albedo"), *ink_albedo)?,
+            }
+        }
+        SurfaceSpec::Phong {
+            reflectance,
+            specular,
+            exponent,
+        } => SurfaceModel::Phong(Phong {
+            reflectance: ctx.fraction(&f("reflectance"), *reflectance)?,
+            specular: ctx.fraction(&f("specular"), *specular)?,
+            exponent: ctx.positive(&f("exponent"), *exponent)?,
+        }),
+        SurfaceSpec::Lambert { albedo } => SurfaceModel::Lambert {
+            albedo: ctx.fraction(&f("albedo"), *albedo)?,
+        },
+        SurfaceSpec::Mirror { reflectance } => SurfaceModel::Mirror {
+            reflectance: ctx.fraction(&f("reflectance"), *reflectance)?,
+        },
+        SurfaceSpec::Absorber {} => SurfaceModel::Absorber,
+    })
+}
+
+/// Fill in each dot pattern's `across` direction from its face and check its axis lies in
+/// the face.
+fn finish_dot_patterns(
+    ctx: &Ctx,
+    mesh: &Mesh,
+    tags: &[String],
+    surfaces: &mut [SurfaceModel],
+) -> Result<()> {
+    for (tag_id, s) in surfaces.iter_mut().enumerate() {
+        let SurfaceModel::Dots { pattern, .. } = s else {
+            continue;
+        };
+        let tag = &tags[tag_id];
+        let prim = mesh
+            .tri_tag
+            .iter()
+            .position(|&t| t as usize == tag_id)
+            .expect("used tag has triangles");
+        let n = mesh.normal(prim as u32);
+        if pattern.axis.dot(n).abs() > 1e-6 {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.axis"),
+                "must lie in the face (it is not perpendicular to the face normal)",
+            ));
+        }
+        if pattern.across == DVec3::ZERO {
+            pattern.across = n.cross(pattern.axis).normalize();
+        } else if pattern.across.dot(n).abs() > 1e-6
+            || pattern.across.dot(pattern.axis).abs() > 1e-6
+        {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.across"),
+                "must lie in the face, perpendicular to axis",
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<Sources> {
+    if specs.is_empty() {
+        return Err(ctx.err("sources", "the scene needs at least one [[sources]] entry"));
+    }
+    let mut list = Vec::new();
+    for (i, s) in specs.iter().enumerate() {
+        let f = |k: &str| format!("sources[{i}].{k}");
+        list.push(match s {
+            SourceSpec::Ccfl {
+                name,
+                center,
+                axis,
+                radius_mm,
+                length_mm,
+                power_w,
+                medium,
+            } => Source {
+                name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
+                power_w: ctx.positive(&f("power_w"), *power_w)?,
+                emitter: Emitter::Ccfl {
+                    center: ctx.point(&f("center"), *center)?,
+                    axis: ctx.direction(&f("axis"), *axis)?,
+                    radius: ctx.positive(&f("radius_mm"), *radius_mm)?,
+                    length: ctx.positive(&f("length_mm"), *length_mm)?,
+                },
+                medium: medium_id(ctx, &f("medium"), medium, media)?,
+            },
+            SourceSpec::Led {
+                name,
+                center,
+                normal,
+                u,
+                width_mm,
+                height_mm,
+                power_w,
+                cos_exponent,
+                medium,
+            } => {
+                let n = ctx.direction(&f("normal"), *normal)?;
+                let u = ctx.direction(&f("u"), *u)?;
+                if u.dot(n).abs() > 1e-6 {
+                    return Err(ctx.err(&f("u"), "must be perpendicular to normal"));
+                }
+                Source {
+                    name: name.clone().unwrap_or_else(|| format!("led{i}")),
+                    power_w: ctx.positive(&f("power_w"), *power_w)?,
+                    emitter: Emitter::Led {
+                        center: ctx.point(&f("center"), *center)?,
+                        normal: n,
+                        u,
+                        width: ctx.positive(&f("width_mm"), *width_mm)?,
+                        height: ctx.positive(&f("height_mm"), *height_mm)?,
+                        cos_exponent: ctx.positive(&f("cos_exponent"), *cos_exponent)?,
+                    },
+                    medium: medium_id(ctx, &f("medium"), medium, media)?,
+                }
+            }
+        });
+    }
+    Ok(Sources::new(list))
+}
+
+fn build_detector(ctx: &Ctx, d: &DetectorSpec) -> Result<TargetPlane> {
+    let u = ctx.direction("detector.u", d.u)?;
+    let v = ctx.direction("detector.v", d.v)?;
+    if u.dot(v).abs() > 1e-6 {
+        return Err(ctx.err("detector.v", "must be perpendicular to detector.u"));
+    }
+    for (k, n) in d.bins.iter().chain(&d.angular_bins).enumerate() {
+        let field = if k < 2 {
+            "detector.bins"
+        } else {
+            "detector.angular_bins"
+        };
+        if *n == 0 || *n > 100_000 {
+            return Err(ctx.err(
+                field,
+                format!("bin counts must be within 1..=100000, got {n}"),
+            ));
+        }
+    }
+    Ok(TargetPlane {
+        origin: ctx.point("detector.origin", d.origin)?,
+        u,
+        v,
+        size: [
+            ctx.positive("detector.size_mm[0]", d.size_mm[0])?,
+            ctx.positive("detector.size_mm[1]", d.size_mm[1])?,
+        ],
+        bins: d.bins,
+        angular_bins: d.angular_bins,
+    })
+}

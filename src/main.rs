@@ -1,1 +1,194 @@
-fn main() {}
+//! The `blutrace` command line: `trace` a scene, `check` a scene file.
+
+use anyhow::Result;
+use blutrace::accel::BackendChoice;
+use blutrace::run::{self, RunOptions};
+use blutrace::scene::Scene;
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Monte Carlo photon tracer for LCD backlight units.
+#[derive(Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Trace photons through a scene and write flux/angular maps and a summary.
+    Trace(TraceArgs),
+    /// Validate a scene and print what it uses.
+    Check {
+        /// Scene file (or a folder holding scene.toml).
+        scene: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct TraceArgs {
+    /// Scene file (or a folder holding scene.toml).
+    scene: PathBuf,
+    /// Photons to emit (default: the scene's [trace] photons).
+    #[arg(long)]
+    photons: Option<u64>,
+    /// Seed of the per-photon random streams (default: the scene's [trace] seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Intersection backend.
+    #[arg(long, value_enum, default_value = "auto")]
+    backend: BackendChoice,
+    /// Output folder (default: out/<scene name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command.execute() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+impl Command {
+    fn execute(self) -> Result<()> {
+        match self {
+            Command::Trace(args) => trace(args),
+            Command::Check { scene } => check(&scene_path(&scene)),
+        }
+    }
+}
+
+/// Accept a scene folder as well as the file itself.
+fn scene_path(p: &Path) -> PathBuf {
+    if p.is_dir() {
+        p.join("scene.toml")
+    } else {
+        p.to_path_buf()
+    }
+}
+
+fn trace(args: TraceArgs) -> Result<()> {
+    let scene = Scene::load(&scene_path(&args.scene))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let options = RunOptions {
+        photons: args.photons.unwrap_or(scene.default_photons),
+        seed: args.seed.unwrap_or(scene.default_seed),
+        threads: args.threads,
+        backend: args.backend,
+    };
+    let bar = progress_bar(options.photons, args.quiet);
+    let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    let out = args
+        .out
+        .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+    let files = result.write(&out)?;
+    print_report(&result.summary(), &files);
+    Ok(())
+}
+
+fn progress_bar(photons: u64, quiet: bool) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let style = ProgressStyle::with_template("{bar:40} {pos}/{len} photons  {per_sec}  eta {eta}")
+        .unwrap_or_else(|_| ProgressStyle::default_bar());
+    ProgressBar::new(photons).with_style(style)
+}
+
+fn print_report(s: &run::Summary, files: &[PathBuf]) {
+    let l = &s.ledger;
+    println!("scene      {} ({})", s.scene, s.scene_file);
+    println!(
+        "traced     {} photons, seed {}, backend {}, {} threads",
+        s.photons, s.seed, s.backend, s.threads
+    );
+    println!(
+        "time       {:.2} s  ({:.0} photons/s, {:.0} interactions/s)",
+        s.runtime_s, s.photons_per_s, s.interactions_per_s
+    );
+    println!(
+        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + escaped {:.4} + killed {:.4}  (balance error {:.1e})",
+        l.emitted_w,
+        l.detected_w,
+        l.absorbed_w.values().sum::<f64>() + l.absorbed_in_medium_w.values().sum::<f64>(),
+        l.escaped_w,
+        l.killed_w,
+        l.balance_rel_error
+    );
+    let u = &s.uniformity;
+    println!(
+        "target     efficiency {:.4} ± {:.4}, mean {:.4e} W/mm², cv {:.3}, min/max {:.3}, 9-pt {:.3}, 13-pt {:.3}",
+        s.extraction_efficiency,
+        s.extraction_efficiency_stderr,
+        u.mean,
+        u.cv,
+        u.min_over_max,
+        u.nine_point_min_over_max,
+        u.thirteen_point_min_over_max
+    );
+    println!(
+        "noise      mean relative stderr per bin {:.3}",
+        s.mean_rel_stderr
+    );
+    for f in files {
+        println!("wrote      {}", f.display());
+    }
+}
+
+fn check(path: &Path) -> Result<()> {
+    let scene = Scene::load(path)?;
+    println!("scene      {} ({})", scene.name, path.display());
+    println!(
+        "geometry   {} triangles, {} tags",
+        scene.mesh.len(),
+        scene.tags.len()
+    );
+    for ((tag, model), n) in scene
+        .tags
+        .iter()
+        .zip(&scene.surfaces)
+        .zip(scene.triangles_per_tag())
+    {
+        println!("  tag {tag:<20} {:<11} {n} triangles", model.kind());
+    }
+    for m in &scene.media {
+        println!(
+            "medium     {:<20} n = {}, absorption {} /mm",
+            m.name, m.n, m.absorption_per_mm
+        );
+    }
+    for s in &scene.sources.list {
+        println!("source     {:<20} {:.3} W", s.name, s.power_w);
+    }
+    let d = &scene.detector;
+    println!(
+        "detector   {} x {} mm, {} x {} bins, {} x {} angular bins",
+        d.size[0], d.size[1], d.bins[0], d.bins[1], d.angular_bins[0], d.angular_bins[1]
+    );
+    println!(
+        "trace      {} photons, seed {}, bounce cap {}",
+        scene.default_photons, scene.default_seed, scene.max_bounces
+    );
+    for w in &scene.warnings {
+        println!("warning    {w}");
+    }
+    println!("ok");
+    Ok(())
+}

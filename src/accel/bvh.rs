@@ -34,7 +34,10 @@ pub struct ObvhsBvh {
 impl ObvhsBvh {
     /// Build the BVH over `mesh`.
     pub fn new(mesh: Arc<Mesh>) -> Self {
-        let pad = 8.0 * f32::EPSILON * (mesh.bounds().max_abs_coordinate() as f32).max(1.0);
+        // Boxes are padded by four spawn offsets: rays start that close to a face, and the
+        // f32 slab test (after CWBVH quantization) must never cull the face they are about
+        // to hit. Found by the hit-for-hit test against brute force.
+        let pad = 4.0 * crate::scene::spawn_epsilon(mesh.bounds().max_abs_coordinate()) as f32;
         let prims: Vec<PaddedTriangle> = (0..mesh.len() as u32)
             .map(|p| padded_box(&mesh, p, pad))
             .collect();
@@ -60,6 +63,23 @@ fn padded_box(mesh: &Mesh, prim: u32, pad: f32) -> PaddedTriangle {
     PaddedTriangle(Aabb::new(min - Vec3A::splat(pad), max + Vec3A::splat(pad)))
 }
 
+/// The ray in f32 for traversal. The inverse direction is computed exactly (in f64,
+/// clamped to the f32 range) rather than by obvhs's `safe_inverse`, which replaces any
+/// component below f32::EPSILON by 1/EPSILON and can then cull the boxes of flat faces
+/// for rays that run nearly parallel to an axis.
+fn f32_ray(ray: &Ray) -> ObRay {
+    let v = |d: glam::DVec3| vec3a(d.x as f32, d.y as f32, d.z as f32);
+    let inv = |c: f64| (1.0 / c).clamp(-(f32::MAX as f64), f32::MAX as f64) as f32;
+    let d = ray.dir;
+    ObRay {
+        origin: v(ray.origin),
+        direction: v(d),
+        inv_direction: vec3a(inv(d.x), inv(d.y), inv(d.z)),
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    }
+}
+
 impl Accel for ObvhsBvh {
     fn name(&self) -> &'static str {
         "bvh"
@@ -67,14 +87,7 @@ impl Accel for ObvhsBvh {
 
     fn intersect(&self, ray: &Ray, tmax: f64) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let o = ray.origin;
-        let d = ray.dir;
-        let ob = ObRay::new(
-            vec3a(o.x as f32, o.y as f32, o.z as f32),
-            vec3a(d.x as f32, d.y as f32, d.z as f32),
-            0.0,
-            f32::INFINITY,
-        );
+        let ob = f32_ray(ray);
         let mut best: Option<Hit> = None;
         let mut hit = RayHit::none();
         bvh.ray_traverse(ob, &mut hit, |_, id| {

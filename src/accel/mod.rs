@@ -7,11 +7,15 @@
 //!
 //! ```toml
 //! # chosen on the command line, not in the scene file:
-//! # blutrace trace SCENE --backend auto|bvh|brute
+//! # blutrace trace SCENE --backend auto|embree|bvh|brute
 //! ```
+//!
+//! `auto` takes Embree when its library loads (see [`embree`] for where it is looked
+//! for), else the BVH; [`Accel::name`] tells which one was built.
 
 pub mod brute;
 pub mod bvh;
+pub mod embree;
 
 use crate::geometry::{Mesh, Ray};
 use std::sync::Arc;
@@ -36,17 +40,25 @@ pub trait Accel: Send + Sync {
 /// Which backend the user asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum BackendChoice {
-    /// The fastest backend available on this machine.
+    /// The fastest backend available on this machine: Embree if its library loads, else
+    /// the BVH.
     Auto,
+    /// Intel Embree 4.4, loaded at run time (an error when it cannot be loaded).
+    Embree,
     /// Pure-Rust BVH (obvhs).
     Bvh,
     /// Every triangle for every ray: the test oracle.
     Brute,
 }
 
-/// Build the backend `choice` over `mesh`.
+/// Build the backend `choice` over `mesh`. Call it inside the rayon pool that will trace:
+/// Embree sizes its thread pool from it.
 pub fn build(choice: BackendChoice, mesh: Arc<Mesh>) -> anyhow::Result<Box<dyn Accel>> {
     Ok(match choice {
+        // Only a library that cannot be loaded (or has the wrong version) means "no
+        // Embree"; a failing build over a loaded library is an error worth reporting.
+        BackendChoice::Auto if embree::info().is_ok() => Box::new(embree::EmbreeAccel::new(mesh)?),
+        BackendChoice::Embree => Box::new(embree::EmbreeAccel::new(mesh)?),
         BackendChoice::Auto | BackendChoice::Bvh => Box::new(bvh::ObvhsBvh::new(mesh)),
         BackendChoice::Brute => Box::new(brute::BruteForce::new(mesh)),
     })

@@ -10,18 +10,16 @@ use glam::DVec3;
 /// into index `n2`, with `cos_i` the cosine of the incidence angle (in `[0, 1]`).
 /// Returns 1 beyond the critical angle (total internal reflection).
 pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
+    if n1 == n2 {
+        return 0.0; // no interface, at every angle including grazing
+    }
     let cos_i = cos_i.clamp(0.0, 1.0);
     match cos_transmitted(cos_i, n1, n2) {
         None => 1.0,
         Some(cos_t) => {
             let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
             let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
-            // At grazing incidence with n1 == n2 both ratios are 0/0: no interface.
-            if n1 == n2 {
-                0.0
-            } else {
-                0.5 * (rs * rs + rp * rp)
-            }
+            0.5 * (rs * rs + rp * rp)
         }
     }
 }

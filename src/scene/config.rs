@@ -206,7 +206,7 @@ pub enum SourceSpec {
         height_mm: f64,
         /// Radiant power (W).
         power_w: f64,
-        /// cos^m exponent (1 = Lambertian).
+        /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere).
         #[serde(default = "one")]
         cos_exponent: f64,
         /// Medium in front of the emitter.

@@ -82,6 +82,14 @@ impl Ctx<'_> {
         }
     }
 
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
+        if self.finite(field, x)? >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be >= 0, got {x}")))
+        }
+    }
+
     fn fraction(&self, field: &str, x: f64) -> Result<f64> {
         if (0.0..=1.0).contains(&self.finite(field, x)?) {
             Ok(x)
@@ -531,7 +539,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                         u,
                         width: ctx.positive(&f("width_mm"), *width_mm)?,
                         height: ctx.positive(&f("height_mm"), *height_mm)?,
-                        cos_exponent: ctx.positive(&f("cos_exponent"), *cos_exponent)?,
+                        cos_exponent: ctx.non_negative(&f("cos_exponent"), *cos_exponent)?,
                     },
                     medium: medium_id(ctx, &f("medium"), medium, media)?,
                 }

@@ -1,0 +1,315 @@
+//! Multi-channel 32-bit float OpenEXR images of 2D grids.
+//!
+//! [`write_channels`] stores any number of equally sized `f32` grids as the channels of a
+//! single-layer, scan-line EXR file with lossless ZIP compression (16-line blocks), plus
+//! numeric header attributes (e.g. `bin_size_x_mm`) stored as EXR `double` attributes.
+//! [`read_channels`] reads such a file back exactly.
+//!
+//! Orientation: grids are row-major, `x` fastest, grid row 0 is the lowest `y`. EXR (like
+//! every image format) stores its top row first, with image `y` pointing down, so the rows
+//! are written in reverse order: grid row 0 is the *bottom* row of the image and the file
+//! looks right (grid `y` up) in any EXR viewer. [`read_channels`] undoes the flip.
+
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+use ::exr::meta::header::standard_names;
+use ::exr::prelude::{
+    AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes,
+    ReadChannels, ReadLayers, SmallVec, Text, WritableImage, read,
+};
+use anyhow::{Context, Result, bail, ensure};
+
+/// The contents of a file read by [`read_channels`]: `(width, height, channels,
+/// attributes)`.
+pub type ChannelImage = (usize, usize, Vec<(String, Vec<f32>)>, Vec<(String, f64)>);
+
+/// Write a `width × height` grid with one `f32` channel per entry of `channels` to the
+/// OpenEXR file `path` (overwriting it), with the numeric header `attributes`.
+///
+/// Each channel slice is row-major (`x` fastest) with row 0 at the lowest `y`; it must hold
+/// exactly `width * height` values. Row 0 is written as the bottom row of the image (see the
+/// module docs). Channel names must be unique, non-empty, Latin-1 and at most 255 bytes;
+/// EXR stores channels in alphabetical order. Attribute names must be unique, follow the
+/// same rules and must not be a standard EXR attribute name (such as `channels`, `owner`,
+/// `dataWindow`); values are stored as EXR `double`. Compression is lossless ZIP.
+///
+/// The file is written directly to `path`; use
+/// [`StagedDir`](crate::output::atomic::StagedDir) for all-or-nothing output.
+pub fn write_channels(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: &[(&str, &[f32])],
+    attributes: &[(&str, f64)],
+) -> Result<()> {
+    let what = || format!("cannot write EXR image {}", path.display());
+    let image = build_image(width, height, channels, attributes).with_context(what)?;
+    image.write().to_file(path).with_context(what)
+}
+
+/// Validate the arguments of [`write_channels`] and assemble the EXR image.
+fn build_image(
+    width: usize,
+    height: usize,
+    channels: &[(&str, &[f32])],
+    attributes: &[(&str, f64)],
+) -> Result<Image<Layer<AnyChannels<FlatSamples>>>> {
+    ensure!(width > 0 && height > 0, "empty grid ({width} × {height})");
+    // EXR stores the data window in i32 coordinates.
+    let max_side = i32::MAX as usize / 2;
+    ensure!(
+        width <= max_side && height <= max_side,
+        "grid {width} × {height} is too large for EXR"
+    );
+    let count = width
+        .checked_mul(height)
+        .with_context(|| format!("grid {width} × {height} is too large"))?;
+    ensure!(!channels.is_empty(), "no channels to write");
+
+    let mut seen = HashSet::new();
+    let mut list = SmallVec::new();
+    for &(name, data) in channels {
+        let text = exr_name(name).with_context(|| format!("invalid channel name {name:?}"))?;
+        ensure!(seen.insert(name), "duplicate channel name {name:?}");
+        ensure!(
+            data.len() == count,
+            "channel {name:?} has {} values, expected {width} × {height} = {count}",
+            data.len()
+        );
+        // Grid row 0 (lowest y) becomes the bottom image row.
+        let flipped: Vec<f32> = data.rchunks_exact(width).flatten().copied().collect();
+        list.push(AnyChannel::new(text, FlatSamples::F32(flipped)));
+    }
+
+    let mut other = HashMap::new();
+    for &(name, value) in attributes {
+        let text = exr_name(name).with_context(|| format!("invalid attribute name {name:?}"))?;
+        ensure!(
+            !standard_names::ALL.contains(&name.as_bytes()),
+            "attribute name {name:?} is reserved by the EXR format"
+        );
+        ensure!(
+            other.insert(text, AttributeValue::F64(value)).is_none(),
+            "duplicate attribute name {name:?}"
+        );
+    }
+    let layer_attributes = LayerAttributes {
+        other,
+        ..LayerAttributes::default()
+    };
+
+    let layer = Layer::new(
+        (width, height),
+        layer_attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    Ok(Image::from_layer(layer))
+}
+
+/// Convert a channel or attribute name to EXR text, checking the format's rules.
+fn exr_name(name: &str) -> Result<Text> {
+    ensure!(!name.is_empty(), "name is empty");
+    ensure!(!name.contains('\0'), "name contains a NUL character");
+    let text = Text::new_or_none(name).context("name has characters outside Latin-1")?;
+    ensure!(text.bytes().len() <= 255, "name is longer than 255 bytes");
+    Ok(text)
+}
+
+/// Read an OpenEXR file written by [`write_channels`]: returns `(width, height, channels,
+/// attributes)`.
+///
+/// The rows are flipped back, so each channel is again row-major with row 0 at the lowest
+/// `y`, exactly as it was passed to [`write_channels`]. Channels come in the file's
+/// (alphabetical) order, samples of any type converted to `f32`. Attributes are the custom
+/// `double` and `float` header attributes (other types are skipped), sorted by name. Only
+/// the first layer and its full resolution level are read.
+pub fn read_channels(path: &Path) -> Result<ChannelImage> {
+    let what = || format!("cannot read EXR image {}", path.display());
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .with_context(what)?;
+
+    let layer = &image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    if width == 0 || height == 0 {
+        bail!("{}: empty image ({width} × {height})", what());
+    }
+    let count = width * height;
+    let mut channels = Vec::with_capacity(layer.channel_data.list.len());
+    for channel in &layer.channel_data.list {
+        let samples: Vec<f32> = channel.sample_data.values_as_f32().collect();
+        ensure!(
+            samples.len() == count,
+            "{}: channel {} has {} samples instead of {width} × {height} (subsampled?)",
+            what(),
+            channel.name,
+            samples.len()
+        );
+        let unflipped = samples.rchunks_exact(width).flatten().copied().collect();
+        channels.push((channel.name.to_string(), unflipped));
+    }
+
+    let mut attributes: Vec<(String, f64)> = image
+        .attributes
+        .other
+        .iter()
+        .chain(&layer.attributes.other)
+        .filter_map(|(name, value)| match value {
+            AttributeValue::F64(v) => Some((name.to_string(), *v)),
+            AttributeValue::F32(v) => Some((name.to_string(), f64::from(*v))),
+            _ => None,
+        })
+        .collect();
+    attributes.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok((width, height, channels, attributes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    /// A unique file path under the system temp dir, removed on drop.
+    struct TempFile(PathBuf);
+
+    impl TempFile {
+        fn new(tag: &str) -> Self {
+            use std::sync::atomic::{AtomicU32, Ordering};
+            static N: AtomicU32 = AtomicU32::new(0);
+            let n = N.fetch_add(1, Ordering::Relaxed);
+            Self(
+                std::env::temp_dir()
+                    .join(format!("blutrace-exr-{tag}-{}-{n}.exr", std::process::id())),
+            )
+        }
+    }
+
+    impl Drop for TempFile {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let (w, h) = (7, 5);
+        let flux: Vec<f32> = (0..w * h)
+            .map(|i| (i as f32 * 0.37).sin() * 1e3 + 1e-7)
+            .collect();
+        let err: Vec<f32> = (0..w * h)
+            .map(|i| if i == 3 { f32::NAN } else { i as f32 / 3.0 })
+            .collect();
+        let count: Vec<f32> = (0..w * h).map(|i| (i * i) as f32).collect();
+        let attrs = [
+            ("bin_size_x_mm", 0.1234567890123),
+            ("bin_size_y_mm", 2.5),
+            ("photons", 1e10),
+        ];
+        let f = TempFile::new("rt");
+        write_channels(
+            &f.0,
+            w,
+            h,
+            &[("flux", &flux), ("count", &count), ("flux_stderr", &err)],
+            &attrs,
+        )
+        .unwrap();
+
+        let (rw, rh, channels, attributes) = read_channels(&f.0).unwrap();
+        assert_eq!((rw, rh), (w, h));
+        let names: Vec<&str> = channels.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(names, ["count", "flux", "flux_stderr"]);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&channels[0].1), bits(&count));
+        assert_eq!(bits(&channels[1].1), bits(&flux));
+        assert_eq!(bits(&channels[2].1), bits(&err));
+        let expected: Vec<(String, f64)> = attrs.iter().map(|&(n, v)| (n.to_string(), v)).collect();
+        assert_eq!(attributes, expected);
+    }
+
+    #[test]
+    fn grid_row_zero_is_the_bottom_image_row() {
+        let (w, h) = (3, 4);
+        let v: Vec<f32> = (0..w * h).map(|i| (i / w) as f32).collect(); // value = grid row
+        let f = TempFile::new("flip");
+        write_channels(&f.0, w, h, &[("Y", &v)], &[]).unwrap();
+        // Read with the plain exr API: its first stored row is the top of the image.
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_file(&f.0)
+            .unwrap();
+        let raw: Vec<f32> = image.layer_data.channel_data.list[0]
+            .sample_data
+            .values_as_f32()
+            .collect();
+        assert_eq!(&raw[..w], &[3.0; 3]); // top row = highest grid row
+        assert_eq!(&raw[raw.len() - w..], &[0.0; 3]); // bottom row = grid row 0
+        assert_eq!(read_channels(&f.0).unwrap().2[0].1, v);
+    }
+
+    #[test]
+    fn compression_is_lossless_zip() {
+        let image = build_image(2, 2, &[("a", &[1.0, 2.0, 3.0, 4.0])], &[]).unwrap();
+        assert_eq!(
+            image.layer_data.encoding.compression,
+            ::exr::prelude::Compression::ZIP16
+        );
+    }
+
+    #[test]
+    fn invalid_arguments_are_errors() {
+        let f = TempFile::new("bad");
+        let four = [0.0f32; 4];
+        let three = [0.0f32; 3];
+        type Case<'a> = (
+            usize,
+            usize,
+            Vec<(&'a str, &'a [f32])>,
+            Vec<(&'a str, f64)>,
+            &'a str,
+        );
+        let cases: Vec<Case> = vec![
+            (2, 2, vec![("a", &three)], vec![], "3 values"),
+            (0, 2, vec![("a", &[])], vec![], "empty grid"),
+            (2, 2, vec![], vec![], "no channels"),
+            (
+                2,
+                2,
+                vec![("a", &four), ("a", &four)],
+                vec![],
+                "duplicate channel",
+            ),
+            (2, 2, vec![("", &four)], vec![], "empty"),
+            (2, 2, vec![("√", &four)], vec![], "Latin-1"),
+            (2, 2, vec![("a", &four)], vec![("owner", 1.0)], "reserved"),
+            (
+                2,
+                2,
+                vec![("a", &four)],
+                vec![("k", 1.0), ("k", 2.0)],
+                "duplicate attribute",
+            ),
+            (usize::MAX, 2, vec![("a", &four)], vec![], "too large"),
+        ];
+        for (w, h, ch, at, msg) in cases {
+            let err = write_channels(&f.0, w, h, &ch, &at).unwrap_err();
+            assert!(
+                format!("{err:#}").contains(msg),
+                "expected {msg:?} in {err:#}"
+            );
+        }
+        assert!(!f.0.exists());
+        assert!(read_channels(&f.0).is_err());
+    }
+}

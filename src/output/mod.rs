@@ -1,0 +1,17 @@
+//! Writing results to disk: generic, scene-agnostic writers.
+//!
+//! - [`atomic`]: [`atomic::StagedDir`] stages every output file of a run under a temporary
+//!   name and renames them into place only when the whole run succeeded, so a failed run
+//!   never leaves a half-written file behind.
+//! - [`exr`]: multi-channel 32-bit float OpenEXR images (lossless ZIP compression) with
+//!   numeric header attributes, plus a reader for the files it writes.
+//! - [`png`]: false-colour previews (viridis colour map with a colour bar) for people.
+//!
+//! Grid convention shared by [`exr`] and [`png`]: a `width × height` grid is a row-major
+//! slice, `x` fastest, and grid row 0 is the `y = 0` row (the lowest `y`). Both writers put
+//! grid row 0 at the *bottom* of the image, so that the picture looks like the plot of the
+//! grid with `y` pointing up.
+
+pub mod atomic;
+pub mod exr;
+pub mod png;

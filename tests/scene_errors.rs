@@ -1,0 +1,195 @@
+//! Bad scene files give clear errors that name the file and the field; never a panic.
+
+mod support;
+
+use blutrace::scene::Scene;
+use support::*;
+
+const GOOD: &str = r#"
+version = 1
+[[geometry]]
+file = "plate.obj"
+[media.pmma]
+n = 1.49
+[surfaces.face]
+model = "dielectric"
+inside = "pmma"
+[surfaces.dots]
+model = "dots"
+inside = "pmma"
+ink_albedo = 0.9
+lattice = "square"
+pitch_mm = 0.5
+origin = [-10.0, 0.0, -0.5]
+axis = [1.0, 0.0, 0.0]
+length_mm = 20.0
+density = [0.2]
+[[sources]]
+type = "ccfl"
+center = [-12.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+radius_mm = 1.0
+length_mm = 20.0
+power_w = 1.0
+[detector]
+origin = [-10.0, -10.0, 0.6]
+u = [1.0, 0.0, 0.0]
+v = [0.0, 1.0, 0.0]
+size_mm = [20.0, 20.0]
+"#;
+
+fn plate() -> String {
+    box_obj(
+        [-10.0, -10.0, -0.5],
+        [10.0, 10.0, 0.5],
+        ["face", "face", "face", "face", "dots", "face"],
+    )
+}
+
+/// Load `toml` (with the plate geometry) and return the error message.
+fn error_of(name: &str, toml: &str) -> String {
+    let obj = plate();
+    let path = write_scene(name, toml, &[("plate.obj", &obj)]);
+    match Scene::load(&path) {
+        Ok(_) => panic!("scene '{name}' loaded but should not have"),
+        Err(e) => format!("{e:#}"),
+    }
+}
+
+fn assert_mentions(msg: &str, words: &[&str]) {
+    for w in words {
+        assert!(msg.contains(w), "error message lacks '{w}': {msg}");
+    }
+}
+
+#[test]
+fn the_good_scene_loads() {
+    let obj = plate();
+    let scene = load(&write_scene("good", GOOD, &[("plate.obj", &obj)]));
+    assert_eq!(scene.tags.len(), 2);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
+#[test]
+fn missing_geometry_file() {
+    let msg = error_of("missing", &GOOD.replace("plate.obj", "nothere.obj"));
+    assert_mentions(
+        &msg,
+        &[
+            "scene.toml",
+            "geometry[0].file",
+            "nothere.obj",
+            "does not exist",
+        ],
+    );
+}
+
+#[test]
+fn tag_without_surface() {
+    let msg = error_of(
+        "unknowntag",
+        &GOOD.replace("[surfaces.face]", "[surfaces.other]"),
+    );
+    assert_mentions(&msg, &["plate.obj", "'face'", "[surfaces.face]"]);
+}
+
+#[test]
+fn unknown_key() {
+    let msg = error_of(
+        "unknownkey",
+        &GOOD.replace("radius_mm = 1.0", "radius_mm = 1.0\nradius = 2.0"),
+    );
+    assert_mentions(&msg, &["scene.toml", "unknown field `radius`"]);
+}
+
+#[test]
+fn nan_value() {
+    let msg = error_of("nan", &GOOD.replace("power_w = 1.0", "power_w = nan"));
+    assert_mentions(&msg, &["scene.toml", "sources[0].power_w", "finite"]);
+}
+
+#[test]
+fn negative_radius() {
+    let msg = error_of(
+        "negradius",
+        &GOOD.replace("radius_mm = 1.0", "radius_mm = -1.0"),
+    );
+    assert_mentions(&msg, &["scene.toml", "sources[0].radius_mm", "> 0"]);
+}
+
+#[test]
+fn density_beyond_packing() {
+    let msg = error_of(
+        "density",
+        &GOOD.replace("density = [0.2]", "density = [1.2]"),
+    );
+    assert_mentions(&msg, &["scene.toml", "surfaces.dots.density", "packing"]);
+    let msg = error_of(
+        "density2",
+        &GOOD.replace("density = [0.2]", "density = [0.2, -0.5]"),
+    );
+    assert_mentions(&msg, &["surfaces.dots.density", "outside [0,"]);
+}
+
+#[test]
+fn wrong_version_and_unknown_medium() {
+    let msg = error_of("version", &GOOD.replace("version = 1", "version = 7"));
+    assert_mentions(&msg, &["version", "7"]);
+    let msg = error_of(
+        "medium",
+        &GOOD.replace(
+            "inside = \"pmma\"\n[surfaces.dots]",
+            "inside = \"glass\"\n[surfaces.dots]",
+        ),
+    );
+    assert_mentions(&msg, &["surfaces.face.inside", "unknown medium 'glass'"]);
+}
+
+#[test]
+fn open_solid_is_refused() {
+    let mut obj = plate();
+    // Drop the last face (two triangles): the PMMA is no longer enclosed.
+    let lines: Vec<&str> = obj.lines().collect();
+    obj = lines[..lines.len() - 2].join("\n");
+    let path = write_scene("open", GOOD, &[("plate.obj", &obj)]);
+    let msg = format!(
+        "{:#}",
+        Scene::load(&path).err().expect("open solid must not load")
+    );
+    assert_mentions(&msg, &["medium 'pmma'", "not enclosed", "open"]);
+}
+
+#[test]
+fn inverted_faces_are_rewound_with_a_warning() {
+    // Reverse the winding of every face: the loader re-orients the solid outward.
+    let obj: String = plate()
+        .lines()
+        .map(|l| match l.strip_prefix("f ") {
+            Some(rest) => {
+                let v: Vec<&str> = rest.split_whitespace().collect();
+                format!("f {} {} {}\n", v[0], v[2], v[1])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    let scene = load(&write_scene("inverted", GOOD, &[("plate.obj", &obj)]));
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("re-wound 12 of 12")),
+        "{:?}",
+        scene.warnings
+    );
+    // Outward: the front face (+z) normal points up.
+    let front = (0..scene.mesh.len() as u32)
+        .find(|&p| scene.mesh.corners(p).iter().all(|c| c.z > 0.0))
+        .unwrap();
+    assert!(scene.mesh.normal(front).z > 0.99);
+}
+
+#[test]
+fn garbage_toml_names_the_file() {
+    let msg = error_of("garbage", "version = 1\n[[geometry]\n");
+    assert_mentions(&msg, &["scene.toml"]);
+}

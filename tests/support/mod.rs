@@ -1,0 +1,92 @@
+//! Shared helpers for integration tests: tiny scenes written to temporary folders.
+#![allow(dead_code)]
+
+use blutrace::accel::BackendChoice;
+use blutrace::run::{self, RunOptions, RunResult};
+use blutrace::scene::Scene;
+use std::fmt::Write;
+use std::path::PathBuf;
+
+/// OBJ text for an axis-aligned box with one tag per face, in the order
+/// -x, +x, -y, +y, -z, +z. Faces are wound outward.
+pub fn box_obj(min: [f64; 3], max: [f64; 3], tags: [&str; 6]) -> String {
+    let mut s = String::new();
+    for i in 0..8 {
+        let p = [
+            if i & 1 == 0 { min[0] } else { max[0] },
+            if i & 2 == 0 { min[1] } else { max[1] },
+            if i & 4 == 0 { min[2] } else { max[2] },
+        ];
+        writeln!(s, "v {} {} {}", p[0], p[1], p[2]).unwrap();
+    }
+    // Corner index = x + 2y + 4z (1-based in OBJ), quads wound outward.
+    let faces = [
+        [0, 4, 6, 2], // -x
+        [1, 3, 7, 5], // +x
+        [0, 1, 5, 4], // -y
+        [2, 6, 7, 3], // +y
+        [0, 2, 3, 1], // -z
+        [4, 5, 7, 6], // +z
+    ];
+    for (f, tag) in faces.iter().zip(tags) {
+        writeln!(s, "usemtl {tag}").unwrap();
+        writeln!(s, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+        writeln!(s, "f {} {} {}", f[0] + 1, f[2] + 1, f[3] + 1).unwrap();
+    }
+    s
+}
+
+/// Write a scene (scene.toml plus named files) into a fresh temporary folder and
+/// return the scene file's path.
+pub fn write_scene(name: &str, toml: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("blutrace-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (f, text) in files {
+        std::fs::write(dir.join(f), text).unwrap();
+    }
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
+}
+
+/// Load a scene written by [`write_scene`], panicking with the loader's message.
+pub fn load(path: &PathBuf) -> Scene {
+    Scene::load(path).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Trace `photons` photons with the BVH backend.
+pub fn trace(scene: &Scene, photons: u64, seed: u64, threads: usize) -> RunResult<'_> {
+    trace_with(scene, photons, seed, threads, BackendChoice::Bvh)
+}
+
+/// Trace with a chosen backend.
+pub fn trace_with(
+    scene: &Scene,
+    photons: u64,
+    seed: u64,
+    threads: usize,
+    backend: BackendChoice,
+) -> RunResult<'_> {
+    let opts = RunOptions {
+        photons,
+        seed,
+        threads: Some(threads),
+        backend,
+    };
+    run::trace(scene, &opts, &|_| {}).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Assert that the ledger balances exactly (every photon has one fate).
+pub fn assert_balanced(r: &RunResult) {
+    let l = &r.tally.ledger;
+    assert_eq!(l.accounted(), l.emitted, "ledger does not balance");
+    assert_eq!(l.emitted.value(), l.photons as f64);
+}
+
+/// Fraction `k / n` and whether it is within `z` standard errors of `p`.
+pub fn within_sigma(k: f64, n: f64, p: f64, z: f64) -> (f64, f64, bool) {
+    let frac = k / n;
+    let sigma = (p * (1.0 - p) / n).sqrt();
+    (frac, sigma, (frac - p).abs() <= z * sigma)
+}

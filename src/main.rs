@@ -2,7 +2,8 @@
 
 use anyhow::Result;
 use blutrace::accel::BackendChoice;
-use blutrace::run::{self, RunOptions};
+use blutrace::optics::surface::Estimator;
+use blutrace::run::{self, RunOptions, TargetMetric};
 use blutrace::scene::Scene;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -33,9 +34,22 @@ enum Command {
 struct TraceArgs {
     /// Scene file (or a folder holding scene.toml).
     scene: PathBuf,
-    /// Photons to emit (default: the scene's [trace] photons).
-    #[arg(long)]
+    /// Photons to emit at most (default: the scene's [trace] photons, or 1e9 with
+    /// --target-error or --max-time).
+    #[arg(long, visible_alias = "max-photons")]
     photons: Option<u64>,
+    /// Stop when the relative standard error of --target-metric is at or below this.
+    #[arg(long)]
+    target_error: Option<f64>,
+    /// The metric --target-error refers to.
+    #[arg(long, value_enum, default_value = "mean")]
+    target_metric: TargetMetric,
+    /// Stop after about this many seconds of tracing.
+    #[arg(long)]
+    max_time: Option<f64>,
+    /// Analog roulette (the paper's) or absorption by weights.
+    #[arg(long, value_enum, default_value = "analog")]
+    estimator: Estimator,
     /// Seed of the per-photon random streams (default: the scene's [trace] seed).
     #[arg(long)]
     seed: Option<u64>,
@@ -86,11 +100,20 @@ fn trace(args: TraceArgs) -> Result<()> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
+    let open_ended = args.target_error.is_some() || args.max_time.is_some();
     let options = RunOptions {
-        photons: args.photons.unwrap_or(scene.default_photons),
+        photons: args.photons.unwrap_or(if open_ended {
+            1_000_000_000
+        } else {
+            scene.default_photons
+        }),
         seed: args.seed.unwrap_or(scene.default_seed),
         threads: args.threads,
         backend: args.backend,
+        estimator: args.estimator,
+        target_error: args.target_error,
+        target_metric: args.target_metric,
+        max_time_s: args.max_time,
     };
     let bar = progress_bar(options.photons, args.quiet);
     let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
@@ -112,40 +135,51 @@ fn progress_bar(photons: u64, quiet: bool) -> ProgressBar {
     ProgressBar::new(photons).with_style(style)
 }
 
-fn print_report(s: &run::Summary, files: &[PathBuf]) {
+fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     let l = &s.ledger;
+    let (u, e) = (&s.uniformity, &s.uniformity_stderr);
+    let absorbed =
+        l.absorbed_w.values().sum::<f64>() + l.absorbed_in_medium_w.values().sum::<f64>();
     println!("scene      {} ({})", s.scene, s.scene_file);
     println!(
-        "traced     {} photons, seed {}, backend {}, {} threads",
-        s.photons, s.seed, s.backend, s.threads
+        "traced     {} photons, seed {}, backend {}, estimator {:?}, {} threads; stopped by {:?}",
+        s.photons, s.seed, s.backend, s.estimator, s.threads, s.stopped_by
     );
     println!(
         "time       {:.2} s  ({:.0} photons/s, {:.0} interactions/s)",
         s.runtime_s, s.photons_per_s, s.interactions_per_s
     );
     println!(
-        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + escaped {:.4} + killed {:.4}  (balance error {:.1e})",
+        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
         l.emitted_w,
         l.detected_w,
-        l.absorbed_w.values().sum::<f64>() + l.absorbed_in_medium_w.values().sum::<f64>(),
+        absorbed,
         l.escaped_w,
         l.killed_w,
+        l.roulette_w,
         l.balance_rel_error
     );
-    let u = &s.uniformity;
     println!(
-        "target     efficiency {:.4} ± {:.4}, mean {:.4e} W/mm², cv {:.3}, min/max {:.3}, 9-pt {:.3}, 13-pt {:.3}",
-        s.extraction_efficiency,
-        s.extraction_efficiency_stderr,
-        u.mean,
+        "efficiency {:.4} ± {:.4} of the emitted power reaches the target",
+        s.extraction_efficiency, s.extraction_efficiency_stderr
+    );
+    println!("flux       mean {:.4e} ± {:.1e} W/mm²", u.mean, e.mean);
+    println!(
+        "uniformity cv {:.3} ± {:.3} (noise floor {:.3}, debiased {:.3}), min/max {:.3} ± {:.3}, 9-pt {:.3} ± {:.3}, 13-pt {:.3} ± {:.3}",
         u.cv,
+        e.cv,
+        s.cv_noise_floor,
+        s.cv_debiased,
         u.min_over_max,
+        e.min_over_max,
         u.nine_point_min_over_max,
-        u.thirteen_point_min_over_max
+        e.nine_point_min_over_max,
+        u.thirteen_point_min_over_max,
+        e.thirteen_point_min_over_max
     );
     println!(
-        "noise      mean relative stderr per bin {:.3}",
-        s.mean_rel_stderr
+        "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {:.3e} ({:?})",
+        s.mean_rel_stderr, s.figure_of_merit.efficiency, s.figure_of_merit.metric
     );
     for f in files {
         println!("wrote      {}", f.display());

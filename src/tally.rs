@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 const FRACTION_BITS: i32 = 64;
 const SCALE: f64 = 18446744073709551616.0; // 2^64
 
-/// An exact sum of non-negative f64 contributions.
+/// An exact sum of f64 contributions of either sign.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ExactSum(pub i128);
 

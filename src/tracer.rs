@@ -9,21 +9,27 @@
 //!
 //! Each photon is traced along straight segments to the nearest surface, where its
 //! surface model decides by Russian roulette to reflect, transmit or absorb it. It ends in
-//! exactly one fate: detected, absorbed (by a named surface or medium), escaped, or killed
-//! by the bounce cap. Work is split into fixed chunks of photon indices; tallies are exact
-//! integer sums, so the result does not depend on the thread count.
+//! exactly one fate: detected, absorbed (by a named surface or medium), escaped, killed
+//! by the bounce cap, or (weighted estimator only) ended by Russian roulette. Work is split
+//! into fixed chunks of photon indices; tallies are exact integer sums, so the result does
+//! not depend on the thread count.
 
 use crate::accel::Accel;
 use crate::geometry::Ray;
-use crate::optics::surface::{MediumId, Outcome};
+use crate::optics::surface::{Estimator, MediumId, Outcome};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
-use crate::tally::{ExactSum, Grid};
+use crate::tally::{BinStats, ExactSum, Grid};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Photons per work unit. Fixed, so results never depend on scheduling.
 pub const CHUNK: u64 = 4096;
+
+/// Weighted estimator: below this weight a photon plays Russian roulette...
+const ROULETTE_BELOW: f64 = 0.1;
+/// ...and survives with probability `w / ROULETTE_SURVIVOR`, then carries this weight.
+const ROULETTE_SURVIVOR: f64 = 0.5;
 
 /// How one photon ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,9 +44,13 @@ pub enum Fate {
     Escaped,
     /// Stopped by the bounce cap.
     Killed,
+    /// Ended by Russian roulette (weighted estimator).
+    Roulette,
 }
 
-/// Where the emitted energy went, in photon weights.
+/// Where the emitted energy went, in photon weights. Partial absorptions of the weighted
+/// estimator are booked as the weight before minus the weight after, so the books close
+/// exactly: `emitted == accounted()` bit for bit in every run.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Ledger {
     /// Photons emitted.
@@ -49,8 +59,8 @@ pub struct Ledger {
     pub interactions: u64,
     /// Emitted weight.
     pub emitted: ExactSum,
-    /// Weight detected on the target.
-    pub detected: ExactSum,
+    /// Weight detected on the target (sum and sum of squares per photon).
+    pub detected: BinStats,
     /// Weight absorbed per surface tag.
     pub absorbed_by_surface: Vec<ExactSum>,
     /// Weight absorbed per medium.
@@ -61,6 +71,8 @@ pub struct Ledger {
     pub killed: ExactSum,
     /// Photons stopped by the bounce cap.
     pub killed_photons: u64,
+    /// Net weight removed by Russian roulette (killed minus weight given to survivors).
+    pub roulette: ExactSum,
 }
 
 impl Ledger {
@@ -72,8 +84,7 @@ impl Ledger {
         }
     }
 
-    fn record(&mut self, fate: Fate, w: f64) {
-        self.emitted.add(w);
+    fn end(&mut self, fate: Fate, w: f64) {
         match fate {
             Fate::Detected => self.detected.add(w),
             Fate::AbsorbedBySurface(t) => self.absorbed_by_surface[t as usize].add(w),
@@ -83,14 +94,21 @@ impl Ledger {
                 self.killed.add(w);
                 self.killed_photons += 1;
             }
+            Fate::Roulette => self.roulette.add(w),
         }
+    }
+
+    /// Book the weight lost between `before` and `after` at `sink`.
+    fn lose(sink: &mut ExactSum, before: f64, after: f64) {
+        sink.add(before);
+        sink.add(-after);
     }
 
     fn merge(&mut self, o: &Ledger) {
         self.photons += o.photons;
         self.interactions += o.interactions;
         self.emitted.merge(o.emitted);
-        self.detected.merge(o.detected);
+        self.detected.merge(&o.detected);
         for (a, b) in self
             .absorbed_by_surface
             .iter_mut()
@@ -108,11 +126,13 @@ impl Ledger {
         self.escaped.merge(o.escaped);
         self.killed.merge(o.killed);
         self.killed_photons += o.killed_photons;
+        self.roulette.merge(o.roulette);
     }
 
     /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances).
     pub fn accounted(&self) -> ExactSum {
-        let mut s = ExactSum(self.detected.0 + self.escaped.0 + self.killed.0);
+        let mut s =
+            ExactSum(self.detected.sum.0 + self.escaped.0 + self.killed.0 + self.roulette.0);
         for a in self
             .absorbed_by_surface
             .iter()
@@ -147,12 +167,43 @@ impl Tally {
     }
 
     /// Add another tally of the same scene.
-    pub fn merge(mut self, o: &Tally) -> Self {
+    pub fn merge(&mut self, o: &Tally) {
         self.flux.merge(&o.flux);
         self.angular.merge(&o.angular);
         self.ledger.merge(&o.ledger);
-        self
     }
+
+    /// Add the events of one traced chunk.
+    pub fn absorb(&mut self, c: &ChunkTally) {
+        for d in &c.detections {
+            self.flux.bins[d.flux_bin as usize].add(d.weight);
+            self.angular.bins[d.angular_bin as usize].add(d.weight);
+        }
+        self.ledger.merge(&c.ledger);
+    }
+}
+
+/// One detected photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detection {
+    /// Index of the flux bin.
+    pub flux_bin: u32,
+    /// Index of the angular bin.
+    pub angular_bin: u32,
+    /// Photon weight at detection.
+    pub weight: f64,
+}
+
+/// What one chunk of photons scored: a list of detections (cheap to ship between
+/// threads) and its ledger.
+#[derive(Clone, Debug)]
+pub struct ChunkTally {
+    /// Index of the chunk (photons `index * CHUNK ..`).
+    pub index: u64,
+    /// Detections, in photon order.
+    pub detections: Vec<Detection>,
+    /// The chunk's ledger.
+    pub ledger: Ledger,
 }
 
 /// Traces photons of one scene through one backend.
@@ -161,87 +212,198 @@ pub struct Tracer<'a> {
     pub scene: &'a Scene,
     /// The intersection backend.
     pub accel: &'a dyn Accel,
+    /// How absorption is sampled.
+    pub estimator: Estimator,
+}
+
+/// A photon in flight.
+struct Photon {
+    ray: Ray,
+    medium: MediumId,
+    weight: f64,
 }
 
 impl Tracer<'_> {
-    /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `tally`.
-    pub fn trace_photon(&self, seed: u64, index: u64, tally: &mut Tally) {
+    /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
+    pub fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
         let (ray, medium) = self.scene.sources.sample(&mut rng);
-        let (fate, events) = self.follow(ray, medium, &mut rng, tally);
-        tally.ledger.photons += 1;
-        tally.ledger.interactions += events;
-        tally.ledger.record(fate, 1.0);
+        let mut p = Photon {
+            ray,
+            medium,
+            weight: 1.0,
+        };
+        out.ledger.photons += 1;
+        out.ledger.emitted.add(1.0);
+        let fate = self.follow(&mut p, &mut rng, out);
+        out.ledger.end(fate, p.weight);
     }
 
     /// The photon loop: nearest event, Beer-Lambert, surface roulette, repeat.
-    fn follow(
-        &self,
-        mut ray: Ray,
-        mut medium: MediumId,
-        rng: &mut PhotonRng,
-        tally: &mut Tally,
-    ) -> (Fate, u64) {
+    fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
-        for bounce in 0..scene.max_bounces as u64 {
-            let hit = self.accel.intersect(&ray, f64::INFINITY);
+        for _ in 0..scene.max_bounces {
+            let hit = self.accel.intersect(&p.ray, f64::INFINITY);
             let t_surface = hit.map_or(f64::INFINITY, |h| h.t);
-            let detected = scene.detector.intersect(&ray, t_surface);
+            let detected = scene.detector.intersect(&p.ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
-            if scene.free_path(medium, rng) < t_next {
-                return (Fate::AbsorbedInMedium(medium), bounce);
+            if !self.cross_medium(p, t_next, rng, &mut out.ledger) {
+                return Fate::AbsorbedInMedium(p.medium);
             }
             if let Some((_, ab)) = detected {
-                score_detection(scene, tally, ab, ray.dir);
-                return (Fate::Detected, bounce);
+                out.detections
+                    .push(detection(scene, ab, p.ray.dir, p.weight));
+                return Fate::Detected;
             }
             let Some(h) = hit else {
-                return (Fate::Escaped, bounce);
+                return Fate::Escaped;
             };
-            let surf = scene.mesh.refine_hit(&ray, h.prim, h.t);
+            out.ledger.interactions += 1;
+            let surf = scene.mesh.refine_hit(&p.ray, h.prim, h.t);
             let tag = scene.mesh.tri_tag[h.prim as usize];
-            match scene.surfaces[tag as usize].interact(&scene.media, &surf, ray.dir, medium, rng) {
-                Outcome::Absorbed => return (Fate::AbsorbedBySurface(tag), bounce + 1),
-                Outcome::Scattered { dir, medium: m } => {
-                    ray = Ray::new(scene.spawn_point(surf.point, surf.normal, dir), dir);
-                    medium = m;
+            let model = &scene.surfaces[tag as usize];
+            match model.interact(
+                &scene.media,
+                &surf,
+                p.ray.dir,
+                p.medium,
+                self.estimator,
+                rng,
+            ) {
+                Outcome::Absorbed => return Fate::AbsorbedBySurface(tag),
+                Outcome::Scattered {
+                    dir,
+                    medium,
+                    weight,
+                } => {
+                    let w = p.weight * weight;
+                    Ledger::lose(
+                        &mut out.ledger.absorbed_by_surface[tag as usize],
+                        p.weight,
+                        w,
+                    );
+                    p.weight = w;
+                    p.ray = Ray::new(scene.spawn_point(surf.point, surf.normal, dir), dir);
+                    p.medium = medium;
                 }
             }
+            if !roulette(p, rng, &mut out.ledger) {
+                return Fate::Roulette;
+            }
         }
-        (Fate::Killed, scene.max_bounces as u64)
+        Fate::Killed
     }
 
-    /// Trace photons `start..end` in parallel. `progress` is told how many photons each
-    /// finished chunk held. The result is identical for any thread count.
+    /// Beer-Lambert over a segment of length `t`: false when the photon is absorbed
+    /// (analog); in weighted mode the weight is attenuated and booked to the medium.
+    fn cross_medium(
+        &self,
+        p: &mut Photon,
+        t: f64,
+        rng: &mut PhotonRng,
+        ledger: &mut Ledger,
+    ) -> bool {
+        let a = self.scene.media[p.medium as usize].absorption_per_mm;
+        if a == 0.0 {
+            return true;
+        }
+        match self.estimator {
+            Estimator::Analog => -(1.0 - rng.uniform()).ln() / a >= t,
+            Estimator::Weighted => {
+                // An escaping photon (t infinite) loses nothing more inside this medium.
+                let w = if t.is_finite() {
+                    p.weight * (-a * t).exp()
+                } else {
+                    p.weight
+                };
+                Ledger::lose(
+                    &mut ledger.absorbed_in_medium[p.medium as usize],
+                    p.weight,
+                    w,
+                );
+                p.weight = w;
+                true
+            }
+        }
+    }
+
+    /// Trace chunk `index` (photons `index*CHUNK .. min(+CHUNK, end)`).
+    pub fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
+        let lo = index * CHUNK;
+        let hi = (lo + CHUNK).min(end);
+        let mut out = ChunkTally {
+            index,
+            detections: Vec::new(),
+            ledger: Ledger::new(self.scene.tags.len(), self.scene.media.len()),
+        };
+        for i in lo..hi {
+            self.trace_photon(seed, i, &mut out);
+        }
+        out
+    }
+
+    /// Trace photons `start..end` (`start` a multiple of [`CHUNK`]) in parallel and hand
+    /// every chunk's events to `sink`, in chunk order. `progress` is told how many photons
+    /// each finished chunk held. The result is identical for any thread count.
     pub fn run_range(
         &self,
         seed: u64,
         start: u64,
         end: u64,
         progress: &(dyn Fn(u64) + Sync),
+        sink: &mut dyn FnMut(&ChunkTally),
+    ) {
+        assert_eq!(start % CHUNK, 0, "ranges start on chunk boundaries");
+        let chunks: Vec<u64> = (start / CHUNK..end.div_ceil(CHUNK)).collect();
+        // Bounded batches keep memory flat however many photons a range holds.
+        for batch in chunks.chunks(256) {
+            let done: Vec<ChunkTally> = batch
+                .par_iter()
+                .map(|&c| {
+                    let t = self.trace_chunk(seed, c, end);
+                    progress(t.ledger.photons);
+                    t
+                })
+                .collect();
+            done.iter().for_each(&mut *sink);
+        }
+    }
+
+    /// Trace photons `start..end` into one tally.
+    pub fn run_tally(
+        &self,
+        seed: u64,
+        start: u64,
+        end: u64,
+        progress: &(dyn Fn(u64) + Sync),
     ) -> Tally {
-        let chunks = (end.saturating_sub(start)).div_ceil(CHUNK);
-        (0..chunks)
-            .into_par_iter()
-            .fold(
-                || Tally::new(self.scene),
-                |mut tally, c| {
-                    let lo = start + c * CHUNK;
-                    let hi = (lo + CHUNK).min(end);
-                    for i in lo..hi {
-                        self.trace_photon(seed, i, &mut tally);
-                    }
-                    progress(hi - lo);
-                    tally
-                },
-            )
-            .reduce(|| Tally::new(self.scene), |a, b| a.merge(&b))
+        let mut tally = Tally::new(self.scene);
+        self.run_range(seed, start, end, progress, &mut |c| tally.absorb(c));
+        tally
     }
 }
 
-fn score_detection(scene: &Scene, tally: &mut Tally, ab: [f64; 2], dir: glam::DVec3) {
-    let (ix, iy) = scene.detector.flux_bin(ab);
-    tally.flux.add(ix, iy, 1.0);
-    let (it, ip) = scene.detector.angular_bin(dir);
-    tally.angular.add(it, ip, 1.0);
+/// Russian roulette on low weights (weighted estimator only): false when the photon dies.
+fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
+    if p.weight >= ROULETTE_BELOW {
+        return true;
+    }
+    if rng.uniform() * ROULETTE_SURVIVOR < p.weight {
+        Ledger::lose(&mut ledger.roulette, p.weight, ROULETTE_SURVIVOR);
+        p.weight = ROULETTE_SURVIVOR;
+        true
+    } else {
+        false
+    }
+}
+
+fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Detection {
+    let d = &scene.detector;
+    let (ix, iy) = d.flux_bin(ab);
+    let (it, ip) = d.angular_bin(dir);
+    Detection {
+        flux_bin: (iy * d.bins[0] + ix) as u32,
+        angular_bin: (ip * d.angular_bins[0] + it) as u32,
+        weight,
+    }
 }

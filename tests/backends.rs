@@ -41,9 +41,8 @@ fn embree(mesh: &Arc<Mesh>) -> Option<EmbreeAccel> {
     }
     Some(EmbreeAccel::new(mesh.clone()).unwrap_or_else(|e| {
         panic!(
-            "the Embree backend is unavailable: {e:#}\n\
-             => run `bash tools/fetch-embree.sh` (or set BLUTRACE_EMBREE to a libembree4.so.4 \
-             of Embree 4.4); on a machine without network set BLUTRACE_SKIP_EMBREE=1 to skip"
+            "the Embree backend is unavailable: {e:#}\n(on a machine without network, set \
+             BLUTRACE_SKIP_EMBREE=1 to skip the Embree checks)"
         )
     }))
 }

@@ -9,7 +9,7 @@ mod support;
 use blutrace::accel::BackendChoice;
 use blutrace::geometry::SurfaceHit;
 use blutrace::optics::fresnel;
-use blutrace::optics::surface::{Interface, Medium, Outcome, SurfaceModel};
+use blutrace::optics::surface::{Estimator, Interface, Medium, Outcome, SurfaceModel};
 use blutrace::rng::PhotonRng;
 use glam::DVec3;
 use support::*;
@@ -54,8 +54,10 @@ fn roulette_reflectance(theta: f64, from_pmma: bool, n: u64) -> f64 {
     let reflected = (0..n)
         .filter(|&i| {
             let mut rng = PhotonRng::new(11, i);
-            match model.interact(&media(), &hit, dir, medium, &mut rng) {
-                Outcome::Scattered { dir: d, medium: m } => {
+            match model.interact(&media(), &hit, dir, medium, Estimator::Analog, &mut rng) {
+                Outcome::Scattered {
+                    dir: d, medium: m, ..
+                } => {
                     assert_eq!(
                         d.dot(DVec3::Z) > 0.0,
                         from_pmma != (m == medium),
@@ -160,7 +162,7 @@ fn isotropic_source_in_slab_traps_sqrt_one_minus_inverse_n_squared() {
         "trapped fraction {frac:.5}, expected {expect:.5} (sigma {sigma:.1e})"
     );
     // The rest leaves through the faces (escaped, or detected above the front face).
-    let out = r.tally.ledger.escaped.value() + r.tally.ledger.detected.value();
+    let out = r.tally.ledger.escaped.value() + r.tally.ledger.detected.sum.value();
     assert_eq!(out + trapped, n as f64);
 }
 
@@ -182,7 +184,7 @@ fn lossless_dot_free_plate_lit_through_its_edge_emits_nothing_through_its_faces(
     let r = trace(&scene, 20_000, 3, 2);
     assert_balanced(&r);
     assert_eq!(
-        r.tally.ledger.detected.value(),
+        r.tally.ledger.detected.sum.value(),
         0.0,
         "light leaked through the front face"
     );
@@ -273,7 +275,7 @@ fn thread_count_and_backend_do_not_change_tallies() {
     let two = trace(&scene, 30_000, 21, 2);
     assert_balanced(&one);
     assert!(
-        one.tally.ledger.detected.value() > 1000.0,
+        one.tally.ledger.detected.sum.value() > 1000.0,
         "the dots must extract light"
     );
     assert_eq!(one.tally, two.tally, "1 and 2 threads differ");

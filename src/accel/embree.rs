@@ -34,7 +34,7 @@ use super::{Accel, Hit};
 use crate::geometry::{Mesh, Ray};
 use anyhow::{Result, anyhow, bail};
 use libloading::Library;
-use std::ffi::{CString, c_char, c_uint};
+use std::ffi::{CString, c_uint};
 use std::path::{Path, PathBuf};
 use std::ptr;
 use std::sync::{Arc, OnceLock};
@@ -286,13 +286,13 @@ fn load() -> Result<Api, String> {
 unsafe fn symbol<T: Copy>(lib: &Library, name: &str) -> Result<T> {
     // SAFETY: forwarded to the caller.
     let sym = unsafe { lib.get::<T>(name.as_bytes()) }
-        .map_err(|e| anyhow!("symbol {name} missing: {e}"))?;
+        .map_err(|e| anyhow::Error::new(e).context(format!("symbol {name} missing")))?;
     Ok(*sym)
 }
 
 fn load_from(path: &Path) -> Result<Api> {
     // SAFETY: loading runs the library's initialisers; Embree's and TBB's are benign.
-    let lib = unsafe { Library::new(path.as_os_str()) }.map_err(|e| anyhow!("{e}"))?;
+    let lib = unsafe { Library::new(path.as_os_str()) }.map_err(anyhow::Error::new)?;
     // SAFETY: each type below is the prototype from the Embree 4.4 headers; the pointers
     // live in `Api` next to the `Library` that keeps them valid, and `Api` is never dropped
     // (it sits in a static).
@@ -319,12 +319,19 @@ fn load_from(path: &Path) -> Result<Api> {
         }
     };
     // A throw-away device to read the version before any struct crosses the boundary.
-    let version = {
-        let device = Device::new(&api, 1)?;
-        device.check_version()?
-    };
-    api.version = version;
-    Ok(api)
+    let version = Device::new(&api, 1).and_then(|device| device.check_version());
+    match version {
+        Ok(v) => {
+            api.version = v;
+            Ok(api)
+        }
+        Err(e) => {
+            // Keep a refused library mapped: unloading a library that may have started
+            // TBB worker threads is not safe.
+            std::mem::forget(api);
+            Err(e)
+        }
+    }
 }
 
 /// An owned `RTCDevice`.
@@ -337,7 +344,7 @@ impl<'a> Device<'a> {
     fn new(api: &'a Api, threads: usize) -> Result<Self> {
         let config = CString::new(format!("threads={}", threads.max(1))).expect("no NUL");
         // SAFETY: a valid NUL-terminated config string.
-        let raw = unsafe { (api.new_device)(config.as_ptr() as *const c_char) };
+        let raw = unsafe { (api.new_device)(config.as_ptr()) };
         if raw.is_null() {
             // SAFETY: a null device asks for the thread's device-creation error.
             let code = unsafe { (api.get_device_error)(ptr::null_mut()) };
@@ -601,7 +608,7 @@ impl Accel for EmbreeAccel {
 
     fn intersect(&self, ray: &Ray, tmax: f64) -> Option<Hit> {
         // Embree needs 0 <= tnear <= tfar; an empty or NaN segment hits nothing.
-        if !(tmax > 0.0) {
+        if tmax.is_nan() || tmax <= 0.0 {
             return None;
         }
         let mut rh = Self::ray_hit(ray, tmax);
@@ -711,7 +718,9 @@ mod tests {
         }
         let mut mesh = unit_triangle();
         mesh.triangles[0][2] = 3;
-        let err = EmbreeAccel::new(Arc::new(mesh)).err().expect("refused");
+        let Err(err) = EmbreeAccel::new(Arc::new(mesh)) else {
+            panic!("out-of-range indices were accepted");
+        };
         assert!(err.to_string().contains("indexes past"), "{err:#}");
     }
 }

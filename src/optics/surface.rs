@@ -104,15 +104,49 @@ pub enum SurfaceModel {
 /// What a surface did to a photon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Outcome {
-    /// The photon leaves in `dir`, now travelling in `medium`.
+    /// The photon leaves in `dir`, now travelling in `medium`, its weight multiplied by
+    /// `weight` (1 in analog mode; the surface's reflectance when absorption is weighted).
     Scattered {
         /// New unit direction.
         dir: DVec3,
         /// Medium the photon now travels in.
         medium: MediumId,
+        /// Factor applied to the photon's weight.
+        weight: f64,
     },
     /// The photon was absorbed by this surface.
     Absorbed,
+}
+
+/// How surface absorption is sampled.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Estimator {
+    /// The paper's analog tracing: absorbed or not by Russian roulette on the albedo.
+    #[default]
+    Analog,
+    /// Absorption by weights: the photon always scatters and carries the albedo as a
+    /// weight factor (and exp(-a t) through absorbing media); Russian roulette only once
+    /// its weight is low. Unbiased, lower variance where absorption is strong.
+    Weighted,
+}
+
+/// A reflection that keeps `albedo` of the photon: roulette (analog) or a weight factor.
+fn survive(albedo: f64, est: Estimator, rng: &mut PhotonRng) -> Option<f64> {
+    match est {
+        Estimator::Analog => (rng.uniform() < albedo).then_some(1.0),
+        Estimator::Weighted => (albedo > 0.0).then_some(albedo),
+    }
 }
 
 impl SurfaceModel {
@@ -123,6 +157,7 @@ impl SurfaceModel {
         hit: &SurfaceHit,
         dir: DVec3,
         medium: MediumId,
+        est: Estimator,
         rng: &mut PhotonRng,
     ) -> Outcome {
         // Normal on the side the photon came from.
@@ -131,7 +166,22 @@ impl SurfaceModel {
         } else {
             -hit.normal
         };
-        let stay = |d: DVec3| Outcome::Scattered { dir: d, medium };
+        let reflect =
+            |albedo: f64, rng: &mut PhotonRng, sample: &dyn Fn(&mut PhotonRng) -> Option<DVec3>| {
+                let Some(weight) = survive(albedo, est, rng) else {
+                    return Outcome::Absorbed;
+                };
+                match sample(rng) {
+                    Some(dir) => Outcome::Scattered {
+                        dir,
+                        medium,
+                        weight,
+                    },
+                    None => Outcome::Absorbed,
+                }
+            };
+        let lambert =
+            |rng: &mut PhotonRng| Some(sampling::lambertian(facing, rng.uniform(), rng.uniform()));
         match self {
             SurfaceModel::Dielectric(i) => dielectric(media, i, hit.normal, dir, rng),
             SurfaceModel::Dots {
@@ -140,21 +190,17 @@ impl SurfaceModel {
                 ink_albedo,
             } => {
                 if pattern.covers(hit.point) {
-                    diffuse(*ink_albedo, facing, rng).map_or(Outcome::Absorbed, stay)
+                    reflect(*ink_albedo, rng, &lambert)
                 } else {
                     dielectric(media, interface, hit.normal, dir, rng)
                 }
             }
-            SurfaceModel::Phong(p) => phong(p, facing, dir, rng).map_or(Outcome::Absorbed, stay),
-            SurfaceModel::Lambert { albedo } => {
-                diffuse(*albedo, facing, rng).map_or(Outcome::Absorbed, stay)
-            }
+            SurfaceModel::Phong(p) => reflect(p.reflectance, rng, &|rng| {
+                phong_direction(p, facing, dir, rng)
+            }),
+            SurfaceModel::Lambert { albedo } => reflect(*albedo, rng, &lambert),
             SurfaceModel::Mirror { reflectance } => {
-                if rng.uniform() < *reflectance {
-                    stay(fresnel::reflect(dir, facing))
-                } else {
-                    Outcome::Absorbed
-                }
+                reflect(*reflectance, rng, &|_| Some(fresnel::reflect(dir, facing)))
             }
             SurfaceModel::Absorber => Outcome::Absorbed,
         }
@@ -202,30 +248,28 @@ fn dielectric(
         return Outcome::Scattered {
             dir: fresnel::reflect(dir, facing),
             medium: from,
+            weight: 1.0,
         };
     }
     match fresnel::refract(dir, facing, n1, n2) {
-        Some(t) => Outcome::Scattered { dir: t, medium: to },
+        Some(t) => Outcome::Scattered {
+            dir: t,
+            medium: to,
+            weight: 1.0,
+        },
         None => Outcome::Scattered {
             dir: fresnel::reflect(dir, facing),
             medium: from,
+            weight: 1.0,
         },
     }
 }
 
-/// Lambertian reflection with probability `albedo` into the hemisphere of `facing`.
-fn diffuse(albedo: f64, facing: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
-    (rng.uniform() < albedo).then(|| sampling::lambertian(facing, rng.uniform(), rng.uniform()))
-}
-
-/// Phong roulette: absorbed, diffuse, or a direction in the specular lobe. A lobe
-/// direction below the surface carries no BRDF value: the photon is absorbed there.
-fn phong(p: &Phong, facing: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
-    let u = rng.uniform();
-    if u >= p.reflectance {
-        return None;
-    }
-    if u >= p.reflectance * p.specular {
+/// A reflected direction from the Phong BRDF, given that the photon is reflected: diffuse
+/// with probability `1 - specular`, else in the cos^n lobe around the mirror direction. A
+/// lobe direction below the surface carries no BRDF value: `None` (absorbed there).
+fn phong_direction(p: &Phong, facing: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
+    if rng.uniform() >= p.specular {
         return Some(sampling::lambertian(facing, rng.uniform(), rng.uniform()));
     }
     let mirror = fresnel::reflect(dir, facing);

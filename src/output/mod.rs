@@ -14,4 +14,5 @@
 
 pub mod atomic;
 pub mod exr;
+pub mod plot;
 pub mod png;

@@ -73,8 +73,14 @@ pub fn trace_with(
         seed,
         threads: Some(threads),
         backend,
+        ..RunOptions::default()
     };
     run::trace(scene, &opts, &|_| {}).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Trace with options given in full.
+pub fn trace_opts<'a>(scene: &'a Scene, opts: &RunOptions) -> RunResult<'a> {
+    run::trace(scene, opts, &|_| {}).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 /// Assert that the ledger balances exactly (every photon has one fate).
@@ -82,6 +88,8 @@ pub fn assert_balanced(r: &RunResult) {
     let l = &r.tally.ledger;
     assert_eq!(l.accounted(), l.emitted, "ledger does not balance");
     assert_eq!(l.emitted.value(), l.photons as f64);
+    let groups: u64 = r.groups.iter().map(|g| g.ledger.photons).sum();
+    assert_eq!(groups, l.photons, "group tallies do not add up to the run");
 }
 
 /// Fraction `k / n` and whether it is within `z` standard errors of `p`.

@@ -1,0 +1,236 @@
+//! From tallies to physical maps and scalar metrics, each with its standard error.
+//!
+//! Per-bin errors come from the per-photon sums of squares (photons are independent).
+//! Scalar metrics that are non-linear in the map (cv, min/max, 9- and 13-point ratios)
+//! get their errors from a delete-one-group jackknife over [`GROUPS`] interleaved photon
+//! groups (chunk `c` belongs to group `c mod GROUPS`), so they too are independent of the
+//! thread count.
+//!
+//! cv and min/max of a noisy map are biased by the noise itself. Beside cv we report its
+//! noise floor, the cv a perfectly uniform source would show at this photon count
+//! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
+
+use crate::scene::Scene;
+use crate::tally::Grid;
+use crate::tracer::Tally;
+use serde::Serialize;
+
+/// Number of interleaved photon groups kept for jackknife errors.
+pub const GROUPS: usize = 32;
+
+/// A map of values with standard errors and photon counts, row-major (x fastest).
+#[derive(Clone, Debug)]
+pub struct Map {
+    /// Bins along x.
+    pub nx: usize,
+    /// Bins along y.
+    pub ny: usize,
+    /// Value per bin.
+    pub value: Vec<f64>,
+    /// Standard error per bin.
+    pub stderr: Vec<f64>,
+    /// Photons scored per bin.
+    pub hits: Vec<u64>,
+}
+
+/// Target-plane irradiance (W/mm^2) per bin.
+pub fn flux_map(scene: &Scene, t: &Tally) -> Map {
+    let area = scene.detector.bin_area();
+    grid_map(scene, t, &t.flux, |_| area)
+}
+
+/// Radiant intensity (W/sr) per (theta, phi) bin; x = phi, y = theta.
+pub fn angular_map(scene: &Scene, t: &Tally) -> Map {
+    let g = &t.angular;
+    let by_theta = grid_map(scene, t, g, |i| {
+        scene.detector.angular_bin_solid_angle(i % g.nx)
+    });
+    let (nt, np) = (g.nx, g.ny);
+    let mut m = Map {
+        nx: np,
+        ny: nt,
+        value: vec![0.0; nt * np],
+        stderr: vec![0.0; nt * np],
+        hits: vec![0; nt * np],
+    };
+    for ip in 0..np {
+        for it in 0..nt {
+            let (src, dst) = (ip * nt + it, it * np + ip);
+            m.value[dst] = by_theta.value[src];
+            m.stderr[dst] = by_theta.stderr[src];
+            m.hits[dst] = by_theta.hits[src];
+        }
+    }
+    m
+}
+
+fn grid_map(scene: &Scene, t: &Tally, g: &Grid, measure: impl Fn(usize) -> f64) -> Map {
+    let n = t.ledger.photons;
+    let total = scene.sources.total_power();
+    let mut m = Map {
+        nx: g.nx,
+        ny: g.ny,
+        value: Vec::new(),
+        stderr: Vec::new(),
+        hits: Vec::new(),
+    };
+    for (i, b) in g.bins.iter().enumerate() {
+        let (mean, se) = b.mean_and_stderr(n);
+        let k = total / measure(i);
+        m.value.push(mean * k);
+        m.stderr.push(se * k);
+        m.hits.push(b.hits);
+    }
+    m
+}
+
+/// Uniformity metrics of a flux map.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Uniformity {
+    /// Mean irradiance over all bins (W/mm^2).
+    pub mean: f64,
+    /// RMS deviation over mean.
+    pub cv: f64,
+    /// Smallest bin over largest bin.
+    pub min_over_max: f64,
+    /// Min over max of the 9 standard points (3x3-bin spots at 1/6, 1/2, 5/6 of each side).
+    pub nine_point_min_over_max: f64,
+    /// As nine-point, plus the 4 points at 1/4 and 3/4 of each side.
+    pub thirteen_point_min_over_max: f64,
+}
+
+impl Uniformity {
+    /// Metrics of `m`'s values.
+    pub fn of(m: &Map) -> Self {
+        let v = &m.value;
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+        let nine = [1.0 / 6.0, 0.5, 5.0 / 6.0];
+        let mut points: Vec<(f64, f64)> = nine
+            .iter()
+            .flat_map(|&y| nine.iter().map(move |&x| (x, y)))
+            .collect();
+        let spot = |pts: &[(f64, f64)]| min_over_max(pts.iter().map(|&(x, y)| spot_mean(m, x, y)));
+        let nine_point = spot(&points);
+        points.extend([(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]);
+        Uniformity {
+            mean,
+            cv: if mean > 0.0 {
+                var.sqrt() / mean
+            } else {
+                f64::NAN
+            },
+            min_over_max: min_over_max(v.iter().copied()),
+            nine_point_min_over_max: nine_point,
+            thirteen_point_min_over_max: spot(&points),
+        }
+    }
+}
+
+fn min_over_max(values: impl Iterator<Item = f64>) -> f64 {
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    if hi > 0.0 { lo / hi } else { f64::NAN }
+}
+
+/// Mean of the 3x3 bins around the fractional position (fx, fy) of the map.
+fn spot_mean(m: &Map, fx: f64, fy: f64) -> f64 {
+    let cx = ((fx * m.nx as f64) as usize).min(m.nx - 1);
+    let cy = ((fy * m.ny as f64) as usize).min(m.ny - 1);
+    let (mut sum, mut n) = (0.0, 0);
+    for y in cy.saturating_sub(1)..=(cy + 1).min(m.ny - 1) {
+        for x in cx.saturating_sub(1)..=(cx + 1).min(m.nx - 1) {
+            sum += m.value[y * m.nx + x];
+            n += 1;
+        }
+    }
+    sum / n as f64
+}
+
+/// The scalar results of a run.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Metrics {
+    /// Flux-map uniformity.
+    pub uniformity: Uniformity,
+    /// Detected over emitted power.
+    pub extraction_efficiency: f64,
+    /// The cv a perfectly uniform source would show at this photon count.
+    pub cv_noise_floor: f64,
+    /// `sqrt(max(cv^2 - floor^2, 0))`: cv with the noise's own contribution removed.
+    pub cv_debiased: f64,
+    /// Mean over lit bins of stderr / flux.
+    pub mean_rel_stderr: f64,
+}
+
+impl Metrics {
+    /// Point estimates from a tally.
+    pub fn of(scene: &Scene, t: &Tally) -> Self {
+        let m = flux_map(scene, t);
+        let u = Uniformity::of(&m);
+        let floor =
+            (m.stderr.iter().map(|s| s * s).sum::<f64>() / m.stderr.len() as f64).sqrt() / u.mean;
+        let (eff, _) = t.ledger.detected.mean_and_stderr(t.ledger.photons);
+        let rel: Vec<f64> = m
+            .value
+            .iter()
+            .zip(&m.stderr)
+            .filter(|(v, _)| **v > 0.0)
+            .map(|(v, s)| s / v)
+            .collect();
+        Metrics {
+            uniformity: u,
+            extraction_efficiency: eff,
+            cv_noise_floor: floor,
+            cv_debiased: (u.cv * u.cv - floor * floor).max(0.0).sqrt(),
+            mean_rel_stderr: if rel.is_empty() {
+                f64::NAN
+            } else {
+                rel.iter().sum::<f64>() / rel.len() as f64
+            },
+        }
+    }
+
+    /// The metrics as named values, in a fixed order (for CSV columns and jackknife).
+    pub fn named(&self) -> [(&'static str, f64); 8] {
+        let u = &self.uniformity;
+        [
+            ("mean", u.mean),
+            ("efficiency", self.extraction_efficiency),
+            ("cv", u.cv),
+            ("cv_debiased", self.cv_debiased),
+            ("min_over_max", u.min_over_max),
+            ("nine_point", u.nine_point_min_over_max),
+            ("thirteen_point", u.thirteen_point_min_over_max),
+            ("mean_rel_stderr", self.mean_rel_stderr),
+        ]
+    }
+}
+
+/// Jackknife standard errors of every named metric from the per-group tallies.
+/// Returns NaN errors when fewer than two groups hold photons.
+pub fn jackknife(scene: &Scene, groups: &[Tally]) -> [f64; 8] {
+    let used: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
+    let k = used.len();
+    if k < 2 {
+        return [f64::NAN; 8];
+    }
+    let leave_out: Vec<[f64; 8]> = (0..k)
+        .map(|skip| {
+            let mut t = Tally::new(scene);
+            used.iter()
+                .enumerate()
+                .filter(|(i, _)| *i != skip)
+                .for_each(|(_, g)| t.merge(g));
+            Metrics::of(scene, &t).named().map(|(_, v)| v)
+        })
+        .collect();
+    let mut se = [0.0; 8];
+    for (j, s) in se.iter_mut().enumerate() {
+        let mean = leave_out.iter().map(|v| v[j]).sum::<f64>() / k as f64;
+        let ss: f64 = leave_out.iter().map(|v| (v[j] - mean).powi(2)).sum();
+        *s = ((k - 1) as f64 / k as f64 * ss).sqrt();
+    }
+    se
+}

@@ -1,0 +1,374 @@
+//! A traced job: photons in rounds until a stopping rule holds, then maps, metrics with
+//! errors, a convergence history and the output files.
+//!
+//! ```text
+//! blutrace trace SCENE [--photons N] [--target-error E [--target-metric M]] [--max-time S]
+//!                      [--estimator analog|weighted]
+//! ```
+//!
+//! Tracing proceeds in rounds of whole photon groups; after each round the metrics and
+//! their standard errors are evaluated and a row is added to the convergence history.
+//! The run stops at the first of: `--photons` reached, the target metric's relative
+//! standard error at or below `--target-error`, or `--max-time` seconds spent.
+//!
+//! Outputs written by [`RunResult::write`]:
+//! - `flux.exr`: channels `flux` (W/mm^2 per bin), `flux_stderr`, `hits`;
+//! - `angular.exr`: channels `intensity` (W/sr per (theta, phi) bin), `intensity_stderr`,
+//!   `hits`; x = phi, y = theta;
+//! - `flux.png`: false-colour preview of the flux map;
+//! - `convergence.csv`, `convergence.png`: metrics and errors against photons and time;
+//! - `summary.json`: run facts, energy ledger, uniformity and errors.
+
+pub mod metrics;
+pub mod summary;
+
+use crate::accel::{self, Accel, BackendChoice};
+use crate::optics::surface::Estimator;
+use crate::output::{self, atomic::StagedDir};
+use crate::scene::Scene;
+use crate::tracer::{CHUNK, Tally, Tracer};
+use anyhow::{Context, Result, bail};
+use metrics::{GROUPS, Map, Metrics};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The metric a `--target-error` refers to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum TargetMetric {
+    /// Mean irradiance over the target.
+    #[default]
+    Mean,
+    /// Detected over emitted power.
+    Efficiency,
+    /// Coefficient of variation of the flux map.
+    Cv,
+    /// 9-point min/max.
+    NinePoint,
+    /// 13-point min/max.
+    ThirteenPoint,
+    /// The mean relative standard error of the lit bins (a per-bin target).
+    Bin,
+}
+
+impl TargetMetric {
+    /// Index into [`Metrics::named`].
+    fn index(self) -> usize {
+        match self {
+            TargetMetric::Mean => 0,
+            TargetMetric::Efficiency => 1,
+            TargetMetric::Cv => 2,
+            TargetMetric::NinePoint => 5,
+            TargetMetric::ThirteenPoint => 6,
+            TargetMetric::Bin => 7,
+        }
+    }
+}
+
+/// How to run a trace.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Photons to emit at most.
+    pub photons: u64,
+    /// Seed of the per-photon streams.
+    pub seed: u64,
+    /// Worker threads (None: all cores).
+    pub threads: Option<usize>,
+    /// Intersection backend.
+    pub backend: BackendChoice,
+    /// How absorption is sampled.
+    pub estimator: Estimator,
+    /// Stop once the target metric's relative standard error is at or below this.
+    pub target_error: Option<f64>,
+    /// The metric `target_error` refers to.
+    pub target_metric: TargetMetric,
+    /// Stop after about this many seconds of tracing.
+    pub max_time_s: Option<f64>,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            photons: 400_000,
+            seed: 1,
+            threads: None,
+            backend: BackendChoice::Auto,
+            estimator: Estimator::Analog,
+            target_error: None,
+            target_metric: TargetMetric::Mean,
+            max_time_s: None,
+        }
+    }
+}
+
+/// Why a run stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StoppedBy {
+    /// The photon budget was spent.
+    Photons,
+    /// The target error was reached.
+    TargetError,
+    /// The time budget was spent.
+    Time,
+}
+
+/// One row of the convergence history, taken after a round.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConvergenceRow {
+    /// Photons traced so far.
+    pub photons: u64,
+    /// Tracing seconds so far.
+    pub seconds: f64,
+    /// Metric values, in [`Metrics::named`] order.
+    pub values: [f64; 8],
+    /// Their standard errors.
+    pub stderr: [f64; 8],
+}
+
+/// A finished trace.
+pub struct RunResult<'a> {
+    /// The scene traced.
+    pub scene: &'a Scene,
+    /// Backend that traced it.
+    pub backend: &'static str,
+    /// Options used.
+    pub options: RunOptions,
+    /// Worker threads used.
+    pub threads: usize,
+    /// Everything scored.
+    pub tally: Tally,
+    /// Per-group tallies (chunk `c` in group `c mod GROUPS`), for jackknife errors.
+    pub groups: Vec<Tally>,
+    /// Wall time of the tracing (s), excluding scene loading and BVH build.
+    pub runtime_s: f64,
+    /// Why it stopped.
+    pub stopped_by: StoppedBy,
+    /// Metrics and errors after each round.
+    pub history: Vec<ConvergenceRow>,
+}
+
+/// Trace `scene` as `options` say. `progress` receives photon counts as chunks finish.
+pub fn trace<'a>(
+    scene: &'a Scene,
+    options: &RunOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RunResult<'a>> {
+    if let Some(e) = options.target_error
+        && !(e > 0.0 && e.is_finite())
+    {
+        bail!("--target-error must be a positive number, got {e}");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads.unwrap_or(0))
+        .build()
+        .context("cannot start worker threads")?;
+    let accel: Box<dyn Accel> =
+        pool.install(|| accel::build(options.backend, scene.mesh.clone()))?;
+    let tracer = Tracer {
+        scene,
+        accel: accel.as_ref(),
+        estimator: options.estimator,
+    };
+    let mut state = Rounds::new(scene);
+    let start = Instant::now();
+    let stopped_by = loop {
+        if let Some(why) = state.stop_reason(options, start.elapsed().as_secs_f64()) {
+            break why;
+        }
+        let end = state.next_round_end(options, start.elapsed().as_secs_f64());
+        pool.install(|| {
+            tracer.run_range(options.seed, state.traced, end, progress, &mut |c| {
+                state.groups[(c.index % GROUPS as u64) as usize].absorb(c);
+                state.total.absorb(c);
+            })
+        });
+        state.traced = end;
+        state.record(scene, start.elapsed().as_secs_f64());
+    };
+    Ok(RunResult {
+        scene,
+        backend: accel.name(),
+        options: options.clone(),
+        threads: pool.current_num_threads(),
+        tally: state.total,
+        groups: state.groups,
+        runtime_s: start.elapsed().as_secs_f64(),
+        stopped_by,
+        history: state.history,
+    })
+}
+
+/// Photons per round unit: one chunk for every group.
+const ROUND_UNIT: u64 = CHUNK * GROUPS as u64;
+
+/// The state of a run between rounds.
+struct Rounds {
+    traced: u64,
+    total: Tally,
+    groups: Vec<Tally>,
+    history: Vec<ConvergenceRow>,
+}
+
+impl Rounds {
+    fn new(scene: &Scene) -> Self {
+        Self {
+            traced: 0,
+            total: Tally::new(scene),
+            groups: vec![Tally::new(scene); GROUPS],
+            history: Vec::new(),
+        }
+    }
+
+    fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
+        if self.traced >= o.photons {
+            return Some(StoppedBy::Photons);
+        }
+        if let (Some(target), Some(row)) = (o.target_error, self.history.last()) {
+            let i = o.target_metric.index();
+            let rel = relative_error(o.target_metric, row.values[i], row.stderr[i]);
+            if rel <= target {
+                return Some(StoppedBy::TargetError);
+            }
+        }
+        match o.max_time_s {
+            Some(t) if elapsed >= t => Some(StoppedBy::Time),
+            _ => None,
+        }
+    }
+
+    /// Rounds grow geometrically (x1.5), in whole round units, so history points are
+    /// evenly spaced on log axes; a round is shrunk to fit the remaining time budget.
+    fn next_round_end(&self, o: &RunOptions, elapsed: f64) -> u64 {
+        let mut size = (self.traced / 2).max(ROUND_UNIT).div_ceil(ROUND_UNIT) * ROUND_UNIT;
+        if let (Some(limit), true) = (o.max_time_s, self.traced > 0 && elapsed > 0.0) {
+            let rate = self.traced as f64 / elapsed;
+            let fits = ((limit - elapsed) * rate) as u64 / ROUND_UNIT * ROUND_UNIT;
+            size = size.min(fits.max(ROUND_UNIT));
+        }
+        (self.traced + size).min(o.photons)
+    }
+
+    fn record(&mut self, scene: &Scene, seconds: f64) {
+        let values = Metrics::of(scene, &self.total).named().map(|(_, v)| v);
+        let mut stderr = metrics::jackknife(scene, &self.groups);
+        // The per-bin target is itself an error: report it without an error of its own.
+        stderr[7] = 0.0;
+        self.history.push(ConvergenceRow {
+            photons: self.traced,
+            seconds,
+            values,
+            stderr,
+        });
+    }
+}
+
+/// Relative standard error of a metric (the per-bin metric is already relative).
+fn relative_error(m: TargetMetric, value: f64, stderr: f64) -> f64 {
+    match m {
+        TargetMetric::Bin => value,
+        _ if value != 0.0 && value.is_finite() => stderr / value.abs(),
+        _ => f64::INFINITY,
+    }
+}
+
+impl RunResult<'_> {
+    /// Target-plane irradiance (W/mm^2) per bin.
+    pub fn flux_map(&self) -> Map {
+        metrics::flux_map(self.scene, &self.tally)
+    }
+
+    /// Radiant intensity (W/sr) per (theta, phi) bin; x = phi, y = theta.
+    pub fn angular_map(&self) -> Map {
+        metrics::angular_map(self.scene, &self.tally)
+    }
+
+    /// Power carried by one photon of unit weight (W).
+    pub fn watts_per_photon(&self) -> f64 {
+        self.scene.sources.total_power() / self.tally.ledger.photons.max(1) as f64
+    }
+
+    /// The last convergence row (metrics and errors of the whole run).
+    pub fn final_row(&self) -> Option<&ConvergenceRow> {
+        self.history.last()
+    }
+
+    /// Write every output into `dir` atomically; returns the files written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let mut staged = StagedDir::new(dir)?;
+        let flux = self.flux_map();
+        let d = &self.scene.detector;
+        let bin = [d.size[0] / d.bins[0] as f64, d.size[1] / d.bins[1] as f64];
+        let common = [
+            ("photons", self.tally.ledger.photons as f64),
+            ("seed", self.options.seed as f64),
+        ];
+        let flux_attrs = [
+            ("bin_size_x_mm", bin[0]),
+            ("bin_size_y_mm", bin[1]),
+            ("size_x_mm", d.size[0]),
+            ("size_y_mm", d.size[1]),
+            common[0],
+            common[1],
+        ];
+        write_map_exr(
+            &mut staged,
+            "flux.exr",
+            &flux,
+            ["flux", "flux_stderr"],
+            &flux_attrs,
+        )?;
+        let ang = self.angular_map();
+        let ang_attrs = [
+            ("bin_theta_deg", 90.0 / ang.ny as f64),
+            ("bin_phi_deg", 360.0 / ang.nx as f64),
+            common[0],
+            common[1],
+        ];
+        write_map_exr(
+            &mut staged,
+            "angular.exr",
+            &ang,
+            ["intensity", "intensity_stderr"],
+            &ang_attrs,
+        )?;
+        let png = staged.stage_path("flux.png");
+        output::png::write_false_colour(
+            &png,
+            flux.nx,
+            flux.ny,
+            &flux.value,
+            &output::png::PreviewOptions::default(),
+        )?;
+        staged.write_bytes(
+            "convergence.csv",
+            summary::convergence_csv(&self.history).as_bytes(),
+        )?;
+        let chart = staged.stage_path("convergence.png");
+        summary::write_convergence_png(&chart, &self.history)?;
+        let json = serde_json::to_vec_pretty(&self.summary())?;
+        staged.write_bytes("summary.json", &json)?;
+        staged.commit()
+    }
+}
+
+fn write_map_exr(
+    staged: &mut StagedDir,
+    name: &str,
+    m: &Map,
+    names: [&str; 2],
+    attrs: &[(&str, f64)],
+) -> Result<()> {
+    let as_f32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (value, stderr) = (as_f32(&m.value), as_f32(&m.stderr));
+    let hits: Vec<f32> = m.hits.iter().map(|&h| h as f32).collect();
+    let path = staged.stage_path(name);
+    output::exr::write_channels(
+        &path,
+        m.nx,
+        m.ny,
+        &[(names[0], &value), (names[1], &stderr), ("hits", &hits)],
+        attrs,
+    )
+}

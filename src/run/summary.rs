@@ -1,0 +1,268 @@
+//! `summary.json`, `convergence.csv` and `convergence.png`.
+
+use super::metrics::{Metrics, Uniformity};
+use super::{ConvergenceRow, RunResult, StoppedBy, TargetMetric, relative_error};
+use crate::optics::surface::Estimator;
+use crate::output::plot::{Chart, Scale, Series, write_chart};
+use anyhow::Result;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::path::Path;
+
+/// summary.json.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Scene file path.
+    pub scene_file: String,
+    /// Backend used.
+    pub backend: String,
+    /// Estimator used.
+    pub estimator: Estimator,
+    /// Seed.
+    pub seed: u64,
+    /// Photons emitted.
+    pub photons: u64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Tracing wall time (s).
+    pub runtime_s: f64,
+    /// Photons per second.
+    pub photons_per_s: f64,
+    /// Surface interactions per second.
+    pub interactions_per_s: f64,
+    /// What ended the run.
+    pub stopped_by: StoppedBy,
+    /// Where the energy went.
+    pub ledger: LedgerSummary,
+    /// Detected over emitted power.
+    pub extraction_efficiency: f64,
+    /// Its standard error.
+    pub extraction_efficiency_stderr: f64,
+    /// Uniformity of the flux map.
+    pub uniformity: Uniformity,
+    /// Standard errors of the uniformity metrics (jackknife over photon groups).
+    pub uniformity_stderr: Uniformity,
+    /// The cv a perfectly uniform source would show at this photon count.
+    pub cv_noise_floor: f64,
+    /// cv with the noise floor removed in quadrature.
+    pub cv_debiased: f64,
+    /// Its standard error.
+    pub cv_debiased_stderr: f64,
+    /// Mean over lit bins of stderr / flux.
+    pub mean_rel_stderr: f64,
+    /// Monte Carlo efficiency of the run.
+    pub figure_of_merit: FigureOfMerit,
+    /// Detector geometry.
+    pub detector: DetectorSummary,
+    /// Scene-loading warnings.
+    pub warnings: Vec<String>,
+}
+
+/// `efficiency = 1 / (rel_error^2 * runtime_s)`: how fast a run buys accuracy. Comparable
+/// between backends and estimators on the same scene and metric.
+#[derive(Clone, Debug, Serialize)]
+pub struct FigureOfMerit {
+    /// The metric whose error is used.
+    pub metric: TargetMetric,
+    /// Its relative standard error.
+    pub rel_error: f64,
+    /// `1 / (rel_error^2 * runtime_s)`.
+    pub efficiency: f64,
+}
+
+/// The energy ledger in watts.
+#[derive(Clone, Debug, Serialize)]
+pub struct LedgerSummary {
+    /// Emitted power.
+    pub emitted_w: f64,
+    /// Power on the target.
+    pub detected_w: f64,
+    /// Power absorbed per surface tag.
+    pub absorbed_w: BTreeMap<String, f64>,
+    /// Power absorbed per medium (Beer-Lambert).
+    pub absorbed_in_medium_w: BTreeMap<String, f64>,
+    /// Power that left the scene.
+    pub escaped_w: f64,
+    /// Power stopped by the bounce cap.
+    pub killed_w: f64,
+    /// Photons stopped by the bounce cap.
+    pub killed_photons: u64,
+    /// Net power removed by Russian roulette (weighted estimator; zero on average).
+    pub roulette_w: f64,
+    /// Surface interactions.
+    pub interactions: u64,
+    /// (accounted - emitted) / emitted, computed on the exact sums.
+    pub balance_rel_error: f64,
+}
+
+/// Detector facts for the summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct DetectorSummary {
+    /// Size (mm).
+    pub size_mm: [f64; 2],
+    /// Flux bins.
+    pub bins: [usize; 2],
+    /// Bin size (mm).
+    pub bin_size_mm: [f64; 2],
+    /// Angular bins (theta, phi).
+    pub angular_bins: [usize; 2],
+}
+
+impl RunResult<'_> {
+    /// The run's summary.
+    pub fn summary(&self) -> Summary {
+        let metrics = Metrics::of(self.scene, &self.tally);
+        let se = self.final_row().map_or([f64::NAN; 8], |r| r.stderr);
+        let l = &self.tally.ledger;
+        let w = self.watts_per_photon();
+        let named = |names: &[String], sums: &[crate::tally::ExactSum]| {
+            names
+                .iter()
+                .zip(sums)
+                .map(|(t, s)| (t.clone(), s.value() * w))
+                .collect()
+        };
+        let media: Vec<String> = self.scene.media.iter().map(|m| m.name.clone()).collect();
+        let (eff, eff_se) = l.detected.mean_and_stderr(l.photons);
+        let d = &self.scene.detector;
+        let target = self.options.target_metric;
+        let rel = relative_error(
+            target,
+            metrics.named()[target.index()].1,
+            se[target.index()],
+        );
+        let runtime = self.runtime_s.max(1e-9);
+        Summary {
+            scene: self.scene.name.clone(),
+            scene_file: self.scene.path.display().to_string(),
+            backend: self.backend.to_string(),
+            estimator: self.options.estimator,
+            seed: self.options.seed,
+            photons: l.photons,
+            threads: self.threads,
+            runtime_s: self.runtime_s,
+            photons_per_s: l.photons as f64 / runtime,
+            interactions_per_s: l.interactions as f64 / runtime,
+            stopped_by: self.stopped_by,
+            ledger: LedgerSummary {
+                emitted_w: l.emitted.value() * w,
+                detected_w: l.detected.sum.value() * w,
+                absorbed_w: named(&self.scene.tags, &l.absorbed_by_surface),
+                absorbed_in_medium_w: named(&media, &l.absorbed_in_medium),
+                escaped_w: l.escaped.value() * w,
+                killed_w: l.killed.value() * w,
+                killed_photons: l.killed_photons,
+                roulette_w: l.roulette.value() * w,
+                interactions: l.interactions,
+                balance_rel_error: (l.accounted().0 - l.emitted.0) as f64
+                    / (l.emitted.0 as f64).max(1.0),
+            },
+            extraction_efficiency: eff,
+            extraction_efficiency_stderr: eff_se,
+            uniformity: metrics.uniformity,
+            uniformity_stderr: Uniformity {
+                mean: se[0],
+                cv: se[2],
+                min_over_max: se[4],
+                nine_point_min_over_max: se[5],
+                thirteen_point_min_over_max: se[6],
+            },
+            cv_noise_floor: metrics.cv_noise_floor,
+            cv_debiased: metrics.cv_debiased,
+            cv_debiased_stderr: se[3],
+            mean_rel_stderr: metrics.mean_rel_stderr,
+            figure_of_merit: FigureOfMerit {
+                metric: target,
+                rel_error: rel,
+                efficiency: 1.0 / (rel * rel * runtime),
+            },
+            detector: DetectorSummary {
+                size_mm: d.size,
+                bins: d.bins,
+                bin_size_mm: [d.size[0] / d.bins[0] as f64, d.size[1] / d.bins[1] as f64],
+                angular_bins: d.angular_bins,
+            },
+            warnings: self.scene.warnings.clone(),
+        }
+    }
+}
+
+/// The convergence history as CSV: photons, seconds, then each metric and its stderr.
+pub fn convergence_csv(history: &[ConvergenceRow]) -> String {
+    let names = Metrics::default().named().map(|(n, _)| n);
+    let mut s = String::from("photons,seconds");
+    for n in names {
+        let _ = write!(s, ",{n},{n}_stderr");
+    }
+    s.push('\n');
+    for r in history {
+        let _ = write!(s, "{},{:.6}", r.photons, r.seconds);
+        for (v, e) in r.values.iter().zip(&r.stderr) {
+            let _ = write!(s, ",{v:.9e},{e:.9e}");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Relative error against run time on log-log axes, with the 1/sqrt(t) reference line.
+pub fn write_convergence_png(path: &Path, history: &[ConvergenceRow]) -> Result<()> {
+    let names = Metrics::default().named().map(|(n, _)| n);
+    let shown = [
+        (0, "mean flux"),
+        (1, "efficiency"),
+        (2, "cv"),
+        (6, "13-point"),
+        (7, "bin (mean)"),
+    ];
+    let mut series: Vec<Series> = shown
+        .iter()
+        .map(|&(i, label)| Series {
+            label: label.to_string(),
+            points: history
+                .iter()
+                .map(|r| {
+                    (
+                        r.seconds,
+                        if names[i] == "mean_rel_stderr" {
+                            r.values[i]
+                        } else {
+                            r.stderr[i] / r.values[i].abs()
+                        },
+                    )
+                })
+                .collect(),
+            dashed: false,
+            markers: true,
+        })
+        .collect();
+    if let Some(first) = history
+        .iter()
+        .find(|r| r.seconds > 0.0 && r.stderr[0] > 0.0)
+    {
+        let e0 = first.stderr[0] / first.values[0];
+        let t_end = history
+            .last()
+            .map_or(first.seconds, |r| r.seconds)
+            .max(first.seconds * 10.0);
+        let reference = [first.seconds, t_end].map(|t| (t, e0 * (first.seconds / t).sqrt()));
+        series.push(Series {
+            label: "1/sqrt(t)".into(),
+            points: reference.to_vec(),
+            dashed: true,
+            markers: false,
+        });
+    }
+    let chart = Chart {
+        title: "Monte Carlo error against run time".into(),
+        x_label: "tracing time (s)".into(),
+        y_label: "relative standard error".into(),
+        x_scale: Scale::Log10,
+        y_scale: Scale::Log10,
+        series,
+    };
+    write_chart(path, &chart)
+}

@@ -13,6 +13,7 @@ pub mod output;
 pub mod rng;
 pub mod run;
 pub mod scene;
+pub mod shard;
 pub mod sources;
 pub mod tally;
 pub mod tracer;

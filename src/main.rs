@@ -3,8 +3,9 @@
 use anyhow::Result;
 use blutrace::accel::BackendChoice;
 use blutrace::optics::surface::Estimator;
-use blutrace::run::{self, RunOptions, TargetMetric};
+use blutrace::run::{self, RunOptions, Shard, TargetMetric};
 use blutrace::scene::Scene;
+use blutrace::shard;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -23,6 +24,8 @@ struct Cli {
 enum Command {
     /// Trace photons through a scene and write flux/angular maps and a summary.
     Trace(TraceArgs),
+    /// Merge shard runs (`trace --shard K/M`) into the outputs of one run.
+    Merge(MergeArgs),
     /// Validate a scene and print what it uses.
     Check {
         /// Scene file (or a folder holding scene.toml).
@@ -62,9 +65,29 @@ struct TraceArgs {
     /// Output folder (default: out/<scene name>).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Trace only shard K of M of the photon indices and write its raw tallies
+    /// (shard.json) for `blutrace merge`.
+    #[arg(long, value_name = "K/M", value_parser = Shard::parse)]
+    shard: Option<Shard>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Shard output folders (or their shard.json files).
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Output folder for the merged results.
+    #[arg(long)]
+    out: PathBuf,
+    /// Merge even if some shards are missing (the result then has fewer photons).
+    #[arg(long)]
+    partial: bool,
+    /// Scene file to use (default: the one recorded in the shards).
+    #[arg(long)]
+    scene: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -81,6 +104,7 @@ impl Command {
     fn execute(self) -> Result<()> {
         match self {
             Command::Trace(args) => trace(args),
+            Command::Merge(args) => merge(args),
             Command::Check { scene } => check(&scene_path(&scene)),
         }
     }
@@ -114,13 +138,25 @@ fn trace(args: TraceArgs) -> Result<()> {
         target_error: args.target_error,
         target_metric: args.target_metric,
         max_time_s: args.max_time,
+        shard: args.shard,
     };
-    let bar = progress_bar(options.photons, args.quiet);
+    let (first, last) = options.photon_range();
+    let bar = progress_bar(last - first, args.quiet);
     let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+    if let Some(sh) = args.shard {
+        let (first, last) = options.photon_range();
+        let file = shard::write_shard(&result, &out)?;
+        println!(
+            "shard      {}/{}: photons {first}..{last} of {} in {:.2} s",
+            sh.index, sh.count, options.photons, result.runtime_s
+        );
+        println!("wrote      {}", file.display());
+        return Ok(());
+    }
     let files = result.write(&out)?;
     print_report(&result.summary(), &files);
     Ok(())
@@ -184,6 +220,39 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     for f in files {
         println!("wrote      {}", f.display());
     }
+}
+
+fn merge(args: MergeArgs) -> Result<()> {
+    let shards = args
+        .shards
+        .iter()
+        .map(|p| Ok((p.clone(), shard::read_shard(p)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let scene_file = match &args.scene {
+        Some(p) => scene_path(p),
+        None => shards[0].1.scene_file.clone(),
+    };
+    let scene = Scene::load(&scene_file)?;
+    let missing = shard::check(&shards, &scene)?;
+    if !missing.is_empty() {
+        let count = shards[0].1.shard.count;
+        let list: Vec<String> = missing.iter().map(|k| format!("{k}/{count}")).collect();
+        if !args.partial {
+            anyhow::bail!(
+                "shards missing: {} (merge them too, or pass --partial)",
+                list.join(", ")
+            );
+        }
+        eprintln!(
+            "warning: merging {} of {count} shards; missing {}: the result has fewer photons",
+            shards.len(),
+            list.join(", ")
+        );
+    }
+    let result = shard::merge(&shards, &scene)?;
+    let files = result.write(&args.out)?;
+    print_report(&result.summary(), &files);
+    Ok(())
 }
 
 fn check(path: &Path) -> Result<()> {

@@ -79,8 +79,9 @@ pub fn mean_and_stderr(sum: f64, sumsq: f64, n: u64) -> (f64, f64) {
     (mean, (var / nf).sqrt())
 }
 
-/// A 2-D grid of bins, row-major (`x` fastest).
+/// A 2-D grid of bins, row-major (`x` fastest). Serialized sparsely (empty bins left out).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(into = "SparseGrid", try_from = "SparseGrid")]
 pub struct Grid {
     /// Bins along x.
     pub nx: usize,
@@ -113,6 +114,51 @@ impl Grid {
     }
 }
 
+/// The stored form of a [`Grid`]: only bins that scored, as `[index, sum, sumsq, hits]`.
+#[derive(Serialize, Deserialize)]
+struct SparseGrid {
+    nx: usize,
+    ny: usize,
+    bins: Vec<(usize, i128, i128, u64)>,
+}
+
+impl From<Grid> for SparseGrid {
+    fn from(g: Grid) -> Self {
+        let bins = g
+            .bins
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.hits > 0 || b.sum.0 != 0)
+            .map(|(i, b)| (i, b.sum.0, b.sumsq.0, b.hits))
+            .collect();
+        SparseGrid {
+            nx: g.nx,
+            ny: g.ny,
+            bins,
+        }
+    }
+}
+
+impl TryFrom<SparseGrid> for Grid {
+    type Error = String;
+
+    fn try_from(s: SparseGrid) -> Result<Self, String> {
+        let mut g = Grid::new(s.nx, s.ny);
+        for (i, sum, sumsq, hits) in s.bins {
+            let bin = g
+                .bins
+                .get_mut(i)
+                .ok_or_else(|| format!("bin index {i} outside a {}x{} grid", s.nx, s.ny))?;
+            *bin = BinStats {
+                sum: ExactSum(sum),
+                sumsq: ExactSum(sumsq),
+                hits,
+            };
+        }
+        Ok(g)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,6 +171,19 @@ mod tests {
         let mut rev = ExactSum::default();
         xs.iter().rev().for_each(|&x| rev.add(x));
         assert_eq!(fwd, rev);
+    }
+
+    #[test]
+    fn grid_round_trips_through_json_sparsely() {
+        let mut g = Grid::new(3, 2);
+        g.add(2, 1, 0.75);
+        g.add(2, 1, 1e-12);
+        let json = serde_json::to_string(&g).unwrap();
+        assert_eq!(json.matches('[').count(), 2, "only one bin stored: {json}");
+        let back: Grid = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, g);
+        let bad = json.replace("[[5,", "[[9,");
+        assert!(serde_json::from_str::<Grid>(&bad).is_err());
     }
 
     #[test]

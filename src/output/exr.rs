@@ -45,7 +45,13 @@ pub fn write_channels(
 ) -> Result<()> {
     let what = || format!("cannot write EXR image {}", path.display());
     let image = build_image(width, height, channels, attributes).with_context(what)?;
-    image.write().to_file(path).with_context(what)
+    // Compress on this thread: parallel compression stores blocks in completion order,
+    // so the same image would give different bytes from run to run.
+    image
+        .write()
+        .non_parallel()
+        .to_file(path)
+        .with_context(what)
 }
 
 /// Validate the arguments of [`write_channels`] and assemble the EXR image.

@@ -6,15 +6,19 @@
 //! font of [`super::png`]. Each axis is linear or logarithmic ([`Scale`]); its range is
 //! chosen automatically from the data with a small margin.
 //!
-//! - Linear axes get 4–6 "nice" ticks (steps of 1, 2, 2.5 or 5 times a power of ten).
-//! - Logarithmic axes get ticks at powers of ten labelled like `1e-3` (every second or
-//!   third power when there are many), unlabelled minor ticks at 2–9 times a power of ten
-//!   when few decades are shown, and always at least two labelled powers of ten.
+//! - Linear axes get about 5 (3–7) "nice" ticks: multiples of 1, 2, 2.5 or 5 times a power
+//!   of ten.
+//! - Logarithmic axes get ticks at powers of ten labelled like `1e-3` (only every n-th
+//!   power when there are many) and always show at least two of them. Up to 6 decades get
+//!   minor ticks at 2–9 times a power of ten; up to 2.5 decades get labels at 2 and 5
+//!   times a power of ten too (`2e-3`, `5e-3`).
 //! - Series are drawn as 2 pixel wide polylines (optionally dashed, optionally with a
 //!   marker at every point) in the colours of the Tableau 10 palette, in order. Markers
 //!   also differ in shape between series.
 //! - Points with a non-finite coordinate, or a non-positive one on a logarithmic axis, are
-//!   skipped, and the line is interrupted there.
+//!   skipped, and the line is interrupted there; a point left alone gets a marker.
+//! - A single point or a constant coordinate gets a range of ±10 % of the value (±1 around
+//!   zero) on a linear axis, and ±½ decade on a logarithmic one.
 //! - The legend goes into the corner of the plot area that hides the least data.
 
 use std::path::Path;
@@ -326,7 +330,8 @@ impl Axis {
     }
 
     /// Ticks at powers of ten (labelled, every `stride`-th one if there are many) and minor
-    /// ticks at 2–9 times a power of ten when at most 6 decades are shown.
+    /// ticks at 2–9 times a power of ten when at most 6 decades are shown; when at most 2.5
+    /// decades are shown, the ones at 2 and 5 times a power of ten are labelled too.
     fn log_ticks(&self, max_labels: usize) -> Vec<Tick> {
         let (lo, hi) = (self.lo, self.hi);
         let eps = 1e-9;
@@ -347,10 +352,11 @@ impl Axis {
             if hi - lo <= 6.0 {
                 for m in 2..=9 {
                     let t = t + f64::from(m).log10();
-                    if t > lo && t < hi {
+                    if t > lo - eps && t < hi + eps {
+                        let labelled = hi - lo <= 2.5 && (m == 2 || m == 5);
                         ticks.push(Tick {
                             frac: frac(t),
-                            label: None,
+                            label: labelled.then(|| format!("{m}e{k}")),
                         });
                     }
                 }
@@ -361,7 +367,8 @@ impl Axis {
 }
 
 /// Labels for the linear tick `values` (multiples of `step`): fixed-point with just enough
-/// decimals for `step` if that is short, else [`format_label`]'s scientific notation.
+/// decimals for `step` if that is short, else [`format_label`]'s scientific notation
+/// (unless its 4 significant digits cannot tell the ticks apart).
 fn linear_labels(values: &[f64], step: f64) -> Vec<String> {
     let decimals = (0..=12)
         .find(|&d| {
@@ -377,9 +384,13 @@ fn linear_labels(values: &[f64], step: f64) -> Vec<String> {
         })
         .collect();
     if fixed.iter().all(|s| s.len() <= 8) {
+        return fixed;
+    }
+    let short: Vec<String> = values.iter().map(|&v| format_label(v)).collect();
+    if short.windows(2).any(|w| w[0] == w[1]) {
         fixed
     } else {
-        values.iter().map(|&v| format_label(v)).collect()
+        short
     }
 }
 
@@ -405,7 +416,7 @@ impl Shape {
     /// Whether the offset `(dx, dy)` from the centre (`dy` down) is inside the marker.
     fn covers(self, dx: i64, dy: i64) -> bool {
         let r = MARKER_R;
-        let tri = |dy: i64| dy.abs() < r && 2 * dx.abs() <= dy + r - 1;
+        let tri = |dy: i64| dy.abs() < r && 2 * dx.abs() < dy + r;
         match self {
             Shape::Circle => dx * dx + dy * dy <= r * r + r / 2,
             Shape::Square => dx.abs() < r && dy.abs() < r,
@@ -568,6 +579,10 @@ struct Legend {
 }
 
 /// A rendered chart, with the geometry the tests need.
+#[cfg_attr(
+    not(test),
+    allow(dead_code, reason = "geometry read by the tests only")
+)]
 struct Rendered {
     width: i64,
     height: i64,
@@ -668,7 +683,8 @@ fn render(chart: &Chart) -> Result<Rendered> {
             let run: Vec<(i64, i64)> = run.iter().flatten().copied().collect();
             match run.len() {
                 0 => {}
-                1 => canvas.fill_rect(Rect::new(run[0].0 - 1, run[0].1 - 1, 4, 4), colour),
+                // A lone point gets a marker even without `markers`.
+                1 => canvas.marker(SHAPES[i % SHAPES.len()], run[0].0, run[0].1, colour),
                 _ => canvas.polyline(&run, colour, s.dashed),
             }
         }
@@ -683,13 +699,17 @@ fn render(chart: &Chart) -> Result<Rendered> {
     // Frame, ticks and tick labels.
     canvas.frame(plot, FRAME);
     let plot_bottom = plot.y + plot.h;
+    let mut free_x = i64::MIN; // labels must not start left of this
     for t in &x_ticks {
         let px = plot.px(t.frac).round() as i64;
         let len = if t.label.is_some() { TICK } else { TICK / 2 };
         canvas.fill_rect(Rect::new(px, plot_bottom + 1, 1, len), FRAME);
         if let Some(label) = &t.label {
-            let top = plot_bottom + 1 + TICK + TICK_GAP;
-            canvas.text(px - text_width(label) / 2, top, label, INK);
+            let (w, top) = (text_width(label), plot_bottom + 1 + TICK + TICK_GAP);
+            if px - w / 2 >= free_x {
+                canvas.text(px - w / 2, top, label, INK);
+                free_x = px - w / 2 + w + CHAR_W;
+            }
         }
     }
     for t in &y_ticks {
@@ -702,17 +722,16 @@ fn render(chart: &Chart) -> Result<Rendered> {
         }
     }
 
-    // Axis labels and title, centred on the plot area (or left-aligned if too long).
-    let centred = |w: i64, lo: i64, len: i64| (lo + (len - w) / 2).max(MARGIN.min(lo));
+    // Axis labels and title, centred on the plot area as far as the image allows (text
+    // too long for the image starts at the left margin and is cut off).
+    let centred = |w: i64| {
+        let x0 = plot.x + (plot.w - w) / 2;
+        x0.min(WIDTH - MARGIN - w).max(MARGIN)
+    };
     if !chart.x_label.is_empty() {
         let w = text_width(&chart.x_label);
         let top = HEIGHT - MARGIN - CHAR_H;
-        canvas.text(
-            centred(w, plot.x, plot.w).min(WIDTH - w).max(0),
-            top,
-            &chart.x_label,
-            INK,
-        );
+        canvas.text(centred(w), top, &chart.x_label, INK);
     }
     if !chart.y_label.is_empty() {
         let w = text_width(&chart.y_label);
@@ -721,7 +740,7 @@ fn render(chart: &Chart) -> Result<Rendered> {
     }
     if !chart.title.is_empty() {
         let w = text_width(&chart.title);
-        let x0 = centred(w, plot.x, plot.w).min(WIDTH - w).max(0);
+        let x0 = centred(w);
         // Bold: the title twice, one pixel apart.
         canvas.text(x0, MARGIN, &chart.title, INK);
         canvas.text(x0 + 1, MARGIN, &chart.title, INK);
@@ -1049,12 +1068,16 @@ mod tests {
             let a = lin(c - span * rand(), c + span * rand() + 1e-300);
             let ticks = a.ticks(8);
             let n = ticks.len();
-            if a.hi - a.lo > 1e-9 * a.lo.abs().max(a.hi.abs()) {
-                assert!((3..=7).contains(&n), "{a:?}: {n} ticks");
-            }
             assert!(ticks.iter().all(|t| (-1e-9..=1.0 + 1e-9).contains(&t.frac)));
             let l = labels(a);
-            assert!(l.iter().all(|s| s.len() <= 10), "{l:?}");
+            if a.hi - a.lo > 1e-9 * a.lo.abs().max(a.hi.abs()) {
+                assert!((3..=7).contains(&n), "{a:?}: {n} ticks");
+                assert!(l.windows(2).all(|w| w[0] != w[1]), "{l:?}");
+            }
+            // Short unless the data sit far from zero compared with their spread.
+            if a.hi - a.lo > 1e-2 * a.lo.abs().max(a.hi.abs()) {
+                assert!(l.iter().all(|s| s.len() <= 10), "{a:?} {l:?}");
+            }
         }
 
         let log = |lo, hi| Axis {
@@ -1063,6 +1086,7 @@ mod tests {
             hi,
         };
         assert_eq!(labels(log(-3.2, 0.5)), ["1e-3", "1e-2", "1e-1", "1e0"]);
+        assert_eq!(labels(log(-1.0, 0.0)), ["1e-1", "2e-1", "5e-1", "1e0"]);
         // Majors 1e-3..1e0; minors 7e-4..9e-4, 2e-3..9e-1 and 2, 3.
         assert_eq!(log(-3.2, 0.5).ticks(8).len(), 4 + 3 + 3 * 8 + 2);
         let many = labels(log(-40.0, 40.0));
@@ -1140,8 +1164,8 @@ mod tests {
                     y_scale: scale,
                     series: (0..14)
                         .map(|i| Series {
-                            dashed: i % 2 == 0,
-                            markers: i % 3 == 0,
+                            dashed: i % 2 == 1,
+                            markers: i % 3 == 1,
                             ..Series::new(format!("series {i} {}", "y".repeat(i * 5)), pts.clone())
                         })
                         .collect(),
@@ -1220,5 +1244,45 @@ mod tests {
             ..Chart::default()
         };
         write_chart(Path::new("/tmp/blutrace_glyphs.png"), &glyphs).unwrap();
+        let degenerate = Chart {
+            title: "Constant y, one lone point, NaN gap".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x_scale: Scale::Log10,
+            y_scale: Scale::Linear,
+            series: vec![
+                Series::new(
+                    "constant",
+                    vec![
+                        (0.2, 3.0),
+                        (0.3, 3.0),
+                        (f64::NAN, 3.0),
+                        (0.5, 3.0),
+                        (0.7, 3.0),
+                    ],
+                ),
+                Series::new("lone point", vec![(0.4, 3.0)]),
+            ],
+        };
+        write_chart(Path::new("/tmp/blutrace_degenerate.png"), &degenerate).unwrap();
+        let many = Chart {
+            title: "Twelve series, offset data, a title far too long to fit the image width".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: (0..12)
+                .map(|i| Series {
+                    markers: i % 2 == 1,
+                    dashed: i % 3 == 2,
+                    ..Series::new(
+                        format!("series {i}"),
+                        (0..20)
+                            .map(|j| (1e6 + f64::from(j) * 0.01, f64::from(i * j)))
+                            .collect(),
+                    )
+                })
+                .collect(),
+            ..Chart::default()
+        };
+        write_chart(Path::new("/tmp/blutrace_many.png"), &many).unwrap();
     }
 }

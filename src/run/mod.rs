@@ -85,6 +85,54 @@ pub struct RunOptions {
     pub target_metric: TargetMetric,
     /// Stop after about this many seconds of tracing.
     pub max_time_s: Option<f64>,
+    /// Trace only this shard of the photon indices `0..photons`.
+    pub shard: Option<Shard>,
+}
+
+/// Shard `index` of `count`: a contiguous run of whole chunks of the photon indices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// Which shard, from 0.
+    pub index: u64,
+    /// How many shards in all.
+    pub count: u64,
+}
+
+impl Shard {
+    /// Parse `K/M` (K from 0 to M-1).
+    pub fn parse(s: &str) -> Result<Shard> {
+        let (k, m) = s
+            .split_once('/')
+            .with_context(|| format!("--shard {s}: expected K/M, e.g. 0/4"))?;
+        let (index, count): (u64, u64) = (
+            k.trim()
+                .parse()
+                .with_context(|| format!("--shard {s}: K is not a number"))?,
+            m.trim()
+                .parse()
+                .with_context(|| format!("--shard {s}: M is not a number"))?,
+        );
+        if count == 0 || index >= count {
+            bail!("--shard {s}: need 0 <= K < M");
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The photon indices this shard traces out of `0..photons`.
+    pub fn range(&self, photons: u64) -> (u64, u64) {
+        let chunks = photons.div_ceil(CHUNK);
+        let first = chunks * self.index / self.count;
+        let last = chunks * (self.index + 1) / self.count;
+        ((first * CHUNK).min(photons), (last * CHUNK).min(photons))
+    }
+}
+
+impl RunOptions {
+    /// The photon indices this run traces.
+    pub fn photon_range(&self) -> (u64, u64) {
+        self.shard
+            .map_or((0, self.photons), |s| s.range(self.photons))
+    }
 }
 
 impl Default for RunOptions {
@@ -98,6 +146,7 @@ impl Default for RunOptions {
             target_error: None,
             target_metric: TargetMetric::Mean,
             max_time_s: None,
+            shard: None,
         }
     }
 }
@@ -160,6 +209,9 @@ pub fn trace<'a>(
     {
         bail!("--target-error must be a positive number, got {e}");
     }
+    if options.shard.is_some() && (options.target_error.is_some() || options.max_time_s.is_some()) {
+        bail!("a shard traces a fixed photon range: --target-error and --max-time do not apply");
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads.unwrap_or(0))
         .build()
@@ -171,7 +223,7 @@ pub fn trace<'a>(
         accel: accel.as_ref(),
         estimator: options.estimator,
     };
-    let mut state = Rounds::new(scene);
+    let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();
     let stopped_by = loop {
         if let Some(why) = state.stop_reason(options, start.elapsed().as_secs_f64()) {
@@ -205,6 +257,8 @@ const ROUND_UNIT: u64 = CHUNK * GROUPS as u64;
 
 /// The state of a run between rounds.
 struct Rounds {
+    first: u64,
+    last: u64,
     traced: u64,
     total: Tally,
     groups: Vec<Tally>,
@@ -212,9 +266,11 @@ struct Rounds {
 }
 
 impl Rounds {
-    fn new(scene: &Scene) -> Self {
+    fn new(scene: &Scene, (first, last): (u64, u64)) -> Self {
         Self {
-            traced: 0,
+            first,
+            last,
+            traced: first,
             total: Tally::new(scene),
             groups: vec![Tally::new(scene); GROUPS],
             history: Vec::new(),
@@ -222,7 +278,7 @@ impl Rounds {
     }
 
     fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
-        if self.traced >= o.photons {
+        if self.traced >= self.last {
             return Some(StoppedBy::Photons);
         }
         if let (Some(target), Some(row)) = (o.target_error, self.history.last()) {
@@ -241,13 +297,14 @@ impl Rounds {
     /// Rounds grow geometrically (x1.5), in whole round units, so history points are
     /// evenly spaced on log axes; a round is shrunk to fit the remaining time budget.
     fn next_round_end(&self, o: &RunOptions, elapsed: f64) -> u64 {
-        let mut size = (self.traced / 2).max(ROUND_UNIT).div_ceil(ROUND_UNIT) * ROUND_UNIT;
-        if let (Some(limit), true) = (o.max_time_s, self.traced > 0 && elapsed > 0.0) {
-            let rate = self.traced as f64 / elapsed;
+        let done = self.traced - self.first;
+        let mut size = (done / 2).max(ROUND_UNIT).div_ceil(ROUND_UNIT) * ROUND_UNIT;
+        if let (Some(limit), true) = (o.max_time_s, done > 0 && elapsed > 0.0) {
+            let rate = done as f64 / elapsed;
             let fits = ((limit - elapsed) * rate) as u64 / ROUND_UNIT * ROUND_UNIT;
             size = size.min(fits.max(ROUND_UNIT));
         }
-        (self.traced + size).min(o.photons)
+        (self.traced + size).min(self.last)
     }
 
     fn record(&mut self, scene: &Scene, seconds: f64) {

@@ -229,11 +229,49 @@ impl Scene {
         }
     }
 
+    /// A 64-bit FNV-1a hash of everything that decides the physics: geometry, tags,
+    /// surface models, media, sources, detector and bounce cap (not the name, path or
+    /// defaults). Shards of one run must agree on it.
+    pub fn content_hash(&self) -> u64 {
+        let mut h = Fnv1a::default();
+        for p in &self.mesh.positions {
+            p.to_array().iter().for_each(|c| h.write(&c.to_le_bytes()));
+        }
+        for (t, tag) in self.mesh.triangles.iter().zip(&self.mesh.tri_tag) {
+            t.iter()
+                .chain(std::iter::once(tag))
+                .for_each(|i| h.write(&i.to_le_bytes()));
+        }
+        let physics = format!(
+            "{:?}{:?}{:?}{:?}{:?}{}",
+            self.tags, self.surfaces, self.media, self.sources, self.detector, self.max_bounces
+        );
+        h.write(physics.as_bytes());
+        h.0
+    }
+
     /// Number of triangles per tag.
     pub fn triangles_per_tag(&self) -> Vec<usize> {
         let mut n = vec![0; self.tags.len()];
         self.mesh.tri_tag.iter().for_each(|&t| n[t as usize] += 1);
         n
+    }
+}
+
+/// 64-bit FNV-1a.
+struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv1a {
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
+        }
     }
 }
 

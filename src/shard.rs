@@ -1,0 +1,238 @@
+//! Sharded runs with exact merging: one run of N photons split over processes or nodes.
+//!
+//! ```text
+//! blutrace trace SCENE --photons N --shard K/M --out DIR_K   # writes DIR_K/shard.json
+//! blutrace merge DIR_0 ... DIR_{M-1} --out DIR [--partial]    # writes the usual outputs
+//! ```
+//!
+//! Shard K of M traces exactly the photon indices a single run of N photons would give it
+//! (whole chunks, the same per-photon random streams). Tallies are exact integer sums,
+//! and chunk `c` always scores into jackknife group `c mod 32`, so merging all M shards
+//! gives tallies bit-identical to the single run. Shards must agree on the scene (content
+//! hash), seed, photon count, shard count and estimator; missing shards are an error unless
+//! `--partial` is given, which merges what is there and says what is missing.
+
+use crate::optics::surface::Estimator;
+use crate::output::atomic::StagedDir;
+use crate::run::{ConvergenceRow, RunOptions, RunResult, Shard, StoppedBy, metrics};
+use crate::scene::Scene;
+use crate::tracer::Tally;
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// File name of a shard's raw tallies inside its output folder.
+pub const SHARD_FILE: &str = "shard.json";
+const FORMAT: &str = "blutrace-shard";
+const FORMAT_VERSION: u32 = 1;
+
+/// A shard's raw tallies and what identifies the run it belongs to.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShardFile {
+    /// Always "blutrace-shard".
+    pub format: String,
+    /// Format version.
+    pub version: u32,
+    /// Scene name.
+    pub scene: String,
+    /// Scene file as given to `trace`.
+    pub scene_file: PathBuf,
+    /// [`Scene::content_hash`], hex.
+    pub scene_hash: String,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Photons of the whole run.
+    pub photons: u64,
+    /// This shard.
+    pub shard: Shard,
+    /// Photon indices traced: `[first, last)`.
+    pub range: [u64; 2],
+    /// Estimator used.
+    pub estimator: Estimator,
+    /// Backend used.
+    pub backend: String,
+    /// Tracing seconds.
+    pub runtime_s: f64,
+    /// Per-group tallies (their sum is the shard's tally).
+    pub groups: Vec<Tally>,
+}
+
+/// Write `result` (a shard run) as `dir/shard.json`, atomically.
+pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
+    let o = &result.options;
+    let shard = o.shard.context("not a shard run")?;
+    let (first, last) = o.photon_range();
+    let file = ShardFile {
+        format: FORMAT.into(),
+        version: FORMAT_VERSION,
+        scene: result.scene.name.clone(),
+        scene_file: result.scene.path.clone(),
+        scene_hash: format!("{:016x}", result.scene.content_hash()),
+        seed: o.seed,
+        photons: o.photons,
+        shard,
+        range: [first, last],
+        estimator: o.estimator,
+        backend: result.backend.to_string(),
+        runtime_s: result.runtime_s,
+        groups: result.groups.clone(),
+    };
+    let mut staged = StagedDir::new(dir)?;
+    staged.write_bytes(SHARD_FILE, &serde_json::to_vec(&file)?)?;
+    Ok(staged.commit()?.remove(0))
+}
+
+/// Read a shard file, or `dir/shard.json` when given a folder.
+pub fn read_shard(path: &Path) -> Result<ShardFile> {
+    let path = if path.is_dir() {
+        path.join(SHARD_FILE)
+    } else {
+        path.to_path_buf()
+    };
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read shard file", path.display()))?;
+    let f: ShardFile = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: not a shard file: {e}", path.display()))?;
+    if f.format != FORMAT || f.version != FORMAT_VERSION {
+        bail!(
+            "{}: format {} version {}, expected {FORMAT} version {FORMAT_VERSION}",
+            path.display(),
+            f.format,
+            f.version
+        );
+    }
+    Ok(f)
+}
+
+/// Check that `shards` belong to one run of `scene` and say which shards are missing.
+pub fn check(shards: &[(PathBuf, ShardFile)], scene: &Scene) -> Result<Vec<u64>> {
+    let (p0, first) = shards.first().context("no shards to merge")?;
+    let hash = format!("{:016x}", scene.content_hash());
+    let mut seen = vec![None::<&Path>; first.shard.count as usize];
+    for (p, s) in shards {
+        let same = |what: &str, a: String, b: String| -> Result<()> {
+            if a != b {
+                bail!(
+                    "{}: {what} is {a}, but {} has {b}: shards of different runs",
+                    p.display(),
+                    p0.display()
+                );
+            }
+            Ok(())
+        };
+        same("scene hash", s.scene_hash.clone(), first.scene_hash.clone())?;
+        same("seed", s.seed.to_string(), first.seed.to_string())?;
+        same(
+            "photon count",
+            s.photons.to_string(),
+            first.photons.to_string(),
+        )?;
+        same(
+            "shard count",
+            s.shard.count.to_string(),
+            first.shard.count.to_string(),
+        )?;
+        same(
+            "estimator",
+            format!("{:?}", s.estimator),
+            format!("{:?}", first.estimator),
+        )?;
+        if s.scene_hash != hash {
+            bail!(
+                "{}: traced a scene with hash {}, but {} now hashes to {hash}: the scene changed",
+                p.display(),
+                s.scene_hash,
+                scene.path.display()
+            );
+        }
+        if [s.range[0], s.range[1]] != {
+            let r = s.shard.range(s.photons);
+            [r.0, r.1]
+        } {
+            bail!(
+                "{}: photon range {:?} is not shard {}/{}'s",
+                p.display(),
+                s.range,
+                s.shard.index,
+                s.shard.count
+            );
+        }
+        match seen[s.shard.index as usize].replace(p) {
+            Some(other) => bail!(
+                "shard {}/{} given twice: {} and {}",
+                s.shard.index,
+                s.shard.count,
+                other.display(),
+                p.display()
+            ),
+            None => continue,
+        }
+    }
+    Ok((0..first.shard.count)
+        .filter(|&k| seen[k as usize].is_none())
+        .collect())
+}
+
+/// Merge checked shards of `scene` into one result, as a single run would have produced.
+pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<RunResult<'a>> {
+    let first = &shards.first().context("no shards to merge")?.1;
+    let mut groups = vec![Tally::new(scene); metrics::GROUPS];
+    for (p, s) in shards {
+        if s.groups.len() != groups.len() {
+            bail!(
+                "{}: {} groups, expected {}",
+                p.display(),
+                s.groups.len(),
+                groups.len()
+            );
+        }
+        for (g, sg) in groups.iter_mut().zip(&s.groups) {
+            if sg.flux.bins.len() != g.flux.bins.len()
+                || sg.angular.bins.len() != g.angular.bins.len()
+            {
+                bail!(
+                    "{}: tally shape does not match the scene's detector",
+                    p.display()
+                );
+            }
+            g.merge(sg);
+        }
+    }
+    let mut total = Tally::new(scene);
+    groups.iter().for_each(|g| total.merge(g));
+    let runtime_s: f64 = shards.iter().map(|(_, s)| s.runtime_s).sum();
+    let values = metrics::Metrics::of(scene, &total).named().map(|(_, v)| v);
+    let mut stderr = metrics::jackknife(scene, &groups);
+    stderr[7] = 0.0;
+    let row = ConvergenceRow {
+        photons: total.ledger.photons,
+        seconds: runtime_s,
+        values,
+        stderr,
+    };
+    let backends: Vec<&str> = shards.iter().map(|(_, s)| s.backend.as_str()).collect();
+    Ok(RunResult {
+        scene,
+        backend: backend_name(&backends),
+        options: RunOptions {
+            photons: first.photons,
+            seed: first.seed,
+            estimator: first.estimator,
+            ..RunOptions::default()
+        },
+        threads: 0,
+        tally: total,
+        groups,
+        runtime_s,
+        stopped_by: StoppedBy::Photons,
+        history: vec![row],
+    })
+}
+
+fn backend_name(names: &[&str]) -> &'static str {
+    let all = |n: &str| names.iter().all(|b| *b == n);
+    ["embree", "bvh", "brute", "convex"]
+        .into_iter()
+        .find(|n| all(n))
+        .unwrap_or("mixed")
+}

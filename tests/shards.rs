@@ -1,0 +1,145 @@
+//! Sharded runs as separate processes, merged, equal one process bit for bit.
+
+use blutrace::output::exr::{ChannelImage, read_channels};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SCENE: &str = "scenes/notebook14";
+const PHOTONS: &str = "150000";
+
+fn blutrace(args: &[&str]) -> std::process::Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args(args)
+        .output()
+        .expect("run blutrace");
+    out
+}
+
+fn ok(args: &[&str]) {
+    let out = blutrace(args);
+    assert!(
+        out.status.success(),
+        "blutrace {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("blutrace-shards-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn shard(dir: &Path, k: usize, m: usize, seed: &str) -> String {
+    let out = dir.join(format!("s{k}"));
+    ok(&[
+        "trace",
+        SCENE,
+        "--photons",
+        PHOTONS,
+        "--seed",
+        seed,
+        "--shard",
+        &format!("{k}/{m}"),
+        "--threads",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    out.to_string_lossy().into_owned()
+}
+
+fn summary_without_timing(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let o = v.as_object_mut().unwrap();
+    for k in [
+        "runtime_s",
+        "photons_per_s",
+        "interactions_per_s",
+        "threads",
+        "figure_of_merit",
+        "backend",
+    ] {
+        o.remove(k);
+    }
+    v
+}
+
+#[test]
+fn four_shards_merge_to_the_single_run_bit_for_bit() {
+    let dir = tmp("equal");
+    let single = dir.join("single");
+    ok(&[
+        "trace",
+        SCENE,
+        "--photons",
+        PHOTONS,
+        "--seed",
+        "5",
+        "--quiet",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    let shards: Vec<String> = (0..4).map(|k| shard(&dir, k, 4, "5")).collect();
+    let merged = dir.join("merged");
+    let mut args: Vec<&str> = vec!["merge"];
+    args.extend(shards.iter().rev().map(String::as_str)); // order must not matter
+    args.extend(["--out", merged.to_str().unwrap()]);
+    ok(&args);
+    // EXR pixel data and attributes, bit for bit (the file bytes may differ: the exr
+    // crate writes header attributes in hash-map order).
+    for f in ["flux.exr", "angular.exr"] {
+        let a = read_channels(&single.join(f)).unwrap();
+        let b = read_channels(&merged.join(f)).unwrap();
+        let bits = |c: &ChannelImage| {
+            c.2.iter()
+                .map(|(n, v)| (n.clone(), v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()))
+                .collect::<Vec<_>>()
+        };
+        assert!(
+            bits(&a) == bits(&b) && a.3 == b.3,
+            "{f} differs between the single run and the merged shards"
+        );
+    }
+    let png = |d: &Path| std::fs::read(d.join("flux.png")).unwrap();
+    assert!(png(&single) == png(&merged), "flux.png differs");
+    assert_eq!(
+        summary_without_timing(&single),
+        summary_without_timing(&merged)
+    );
+}
+
+#[test]
+fn missing_duplicate_and_foreign_shards_are_errors() {
+    let dir = tmp("bad");
+    let s0 = shard(&dir, 0, 3, "9");
+    let s1 = shard(&dir, 1, 3, "9");
+    let out = dir.join("m");
+    let out = out.to_str().unwrap();
+    let err = blutrace(&["merge", &s0, &s1, "--out", out]);
+    assert!(!err.status.success());
+    assert!(
+        String::from_utf8_lossy(&err.stderr).contains("shards missing: 2/3"),
+        "{}",
+        String::from_utf8_lossy(&err.stderr)
+    );
+    assert!(
+        !Path::new(out).exists(),
+        "a failed merge must not write outputs"
+    );
+    let partial = blutrace(&["merge", &s0, &s1, "--partial", "--out", out]);
+    assert!(partial.status.success());
+    assert!(String::from_utf8_lossy(&partial.stderr).contains("missing 2/3"));
+    let dup = blutrace(&["merge", &s0, &s0, "--out", out]);
+    assert!(String::from_utf8_lossy(&dup.stderr).contains("given twice"));
+    let other_dir = tmp("other");
+    let foreign = shard(&other_dir, 2, 3, "10");
+    let mixed = blutrace(&["merge", &s0, &s1, &foreign, "--out", out]);
+    assert!(
+        String::from_utf8_lossy(&mixed.stderr).contains("seed is 10"),
+        "{}",
+        String::from_utf8_lossy(&mixed.stderr)
+    );
+}

@@ -6,6 +6,7 @@
 //! [`output`] (EXR, PNG, JSON) and [`run`] (a whole traced job with its summary).
 
 pub mod accel;
+pub mod bench;
 pub mod detector;
 pub mod geometry;
 pub mod optics;

@@ -26,6 +26,18 @@ enum Command {
     Trace(TraceArgs),
     /// Merge shard runs (`trace --shard K/M`) into the outputs of one run.
     Merge(MergeArgs),
+    /// Measure photons/s per backend (ratios in one run; see the README's table).
+    Bench {
+        /// Photons per configuration.
+        #[arg(long, default_value_t = 200_000)]
+        photons: u64,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// The notebook scene folder.
+        #[arg(long, default_value = "scenes/notebook14")]
+        scene: PathBuf,
+    },
     /// Validate a scene and print what it uses.
     Check {
         /// Scene file (or a folder holding scene.toml).
@@ -69,6 +81,9 @@ struct TraceArgs {
     /// (shard.json) for `blutrace merge`.
     #[arg(long, value_name = "K/M", value_parser = Shard::parse)]
     shard: Option<Shard>,
+    /// Do not use the convex-solid fast path (every ray goes through the backend).
+    #[arg(long)]
+    no_convex: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -105,6 +120,11 @@ impl Command {
         match self {
             Command::Trace(args) => trace(args),
             Command::Merge(args) => merge(args),
+            Command::Bench {
+                photons,
+                threads,
+                scene,
+            } => bench(&scene, photons, threads),
             Command::Check { scene } => check(&scene_path(&scene)),
         }
     }
@@ -139,6 +159,7 @@ fn trace(args: TraceArgs) -> Result<()> {
         target_metric: args.target_metric,
         max_time_s: args.max_time,
         shard: args.shard,
+        convex: !args.no_convex,
     };
     let (first, last) = options.photon_range();
     let bar = progress_bar(last - first, args.quiet);
@@ -255,6 +276,34 @@ fn merge(args: MergeArgs) -> Result<()> {
     Ok(())
 }
 
+fn bench(scene: &Path, photons: u64, threads: Option<usize>) -> Result<()> {
+    println!(
+        "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
+    );
+    println!("|---|---:|---|---|---:|---:|---:|");
+    for r in blutrace::bench::trace_table(scene, photons, threads)? {
+        println!(
+            "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
+            r.scene,
+            r.triangles,
+            r.backend,
+            if r.convex { "on" } else { "off" },
+            r.photons_per_s,
+            r.interactions_per_s,
+            r.ratio_to_obvhs
+        );
+    }
+    println!();
+    let table = blutrace::bench::in_guide_table(scene, 1_000_000)?;
+    let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
+    println!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
+    println!("|---|---:|---:|");
+    for (name, q) in &table {
+        println!("| {name} | {q:.0} | {:.2} |", convex / q);
+    }
+    Ok(())
+}
+
 fn check(path: &Path) -> Result<()> {
     let scene = Scene::load(path)?;
     println!("scene      {} ({})", scene.name, path.display());
@@ -271,12 +320,19 @@ fn check(path: &Path) -> Result<()> {
     {
         println!("  tag {tag:<20} {:<11} {n} triangles", model.kind());
     }
-    for m in &scene.media {
+    for (i, m) in scene.media.iter().enumerate() {
+        let path = match scene.convex_solid(i as u16) {
+            Some(s) => format!("convex fast path ({} planes)", s.plane_count()),
+            None if i == 0 => "ambient".to_string(),
+            None => "backend (not a lone convex solid)".to_string(),
+        };
         println!(
-            "medium     {:<20} n = {}, absorption {} /mm",
+            "medium     {:<20} n = {}, absorption {} /mm; {path}",
             m.name, m.n, m.absorption_per_mm
         );
     }
+    let backend = blutrace::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
+    println!("backend    auto picks {}", backend.name());
     for s in &scene.sources.list {
         println!("source     {:<20} {:.3} W", s.name, s.power_w);
     }

@@ -214,6 +214,8 @@ pub struct Tracer<'a> {
     pub accel: &'a dyn Accel,
     /// How absorption is sampled.
     pub estimator: Estimator,
+    /// Use the convex-solid fast path inside convex media.
+    pub convex: bool,
 }
 
 /// A photon in flight.
@@ -243,7 +245,10 @@ impl Tracer<'_> {
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
         for _ in 0..scene.max_bounces {
-            let hit = self.accel.intersect(&p.ray, f64::INFINITY);
+            let hit = match scene.convex_solid(p.medium).filter(|_| self.convex) {
+                Some(solid) => solid.exit(&scene.mesh, &p.ray),
+                None => self.accel.intersect(&p.ray, f64::INFINITY),
+            };
             let t_surface = hit.map_or(f64::INFINITY, |h| h.t);
             let detected = scene.detector.intersect(&p.ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);

@@ -15,6 +15,7 @@
 
 pub mod brute;
 pub mod bvh;
+pub mod convex;
 pub mod embree;
 
 use crate::geometry::{Mesh, Ray};

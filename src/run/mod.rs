@@ -87,6 +87,8 @@ pub struct RunOptions {
     pub max_time_s: Option<f64>,
     /// Trace only this shard of the photon indices `0..photons`.
     pub shard: Option<Shard>,
+    /// Use the convex-solid fast path where a scene allows it.
+    pub convex: bool,
 }
 
 /// Shard `index` of `count`: a contiguous run of whole chunks of the photon indices.
@@ -147,6 +149,7 @@ impl Default for RunOptions {
             target_metric: TargetMetric::Mean,
             max_time_s: None,
             shard: None,
+            convex: true,
         }
     }
 }
@@ -222,6 +225,7 @@ pub fn trace<'a>(
         scene,
         accel: accel.as_ref(),
         estimator: options.estimator,
+        convex: options.convex,
     };
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();

@@ -12,6 +12,7 @@ pub mod config;
 pub mod meshio;
 mod solids;
 
+use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};
 use crate::optics::dots::DotPattern;
@@ -56,6 +57,8 @@ pub struct Scene {
     pub spawn_eps: f64,
     /// Non-fatal findings of loading, for the user.
     pub warnings: Vec<String>,
+    /// Per medium: its convex solid when the fast path applies (see [`ConvexSolid`]).
+    pub convex: Vec<Option<ConvexSolid>>,
 }
 
 /// Names an error's place: file and field.
@@ -177,8 +180,10 @@ impl Scene {
             offset: DVec3::ZERO,
             spawn_eps: 0.0,
             warnings,
+            convex: Vec::new(),
         };
         scene.recenter();
+        scene.convex = convex_solids(&scene);
         Ok(scene)
     }
 
@@ -250,12 +255,85 @@ impl Scene {
         h.0
     }
 
+    /// Split every triangle of `tag` into `4^levels` (edge midpoints): the same surface
+    /// with more triangles, for benchmarks and agreement tests on large meshes.
+    pub fn subdivide_tag(&mut self, tag: &str, levels: u32) -> Result<()> {
+        let id = self
+            .tags
+            .iter()
+            .position(|t| t == tag)
+            .with_context(|| format!("no tag '{tag}' in {}", self.path.display()))?;
+        let mesh = Arc::make_mut(&mut self.mesh);
+        for _ in 0..levels {
+            let old = std::mem::take(&mut mesh.triangles);
+            let old_tags = std::mem::take(&mut mesh.tri_tag);
+            for (tri, t) in old.into_iter().zip(old_tags) {
+                if t as usize != id {
+                    mesh.triangles.push(tri);
+                    mesh.tri_tag.push(t);
+                    continue;
+                }
+                let [a, b, c] = tri;
+                let mut mid = |u: u32, v: u32| {
+                    let p = 0.5 * (mesh.positions[u as usize] + mesh.positions[v as usize]);
+                    mesh.positions.push(p);
+                    mesh.positions.len() as u32 - 1
+                };
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                for child in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+                    mesh.triangles.push(child);
+                    mesh.tri_tag.push(t);
+                }
+            }
+        }
+        self.convex = convex_solids(self);
+        Ok(())
+    }
+
+    /// The convex solid of `medium`, when the fast path applies to it.
+    pub fn convex_solid(&self, medium: MediumId) -> Option<&ConvexSolid> {
+        self.convex.get(medium as usize)?.as_ref()
+    }
+
     /// Number of triangles per tag.
     pub fn triangles_per_tag(&self) -> Vec<usize> {
         let mut n = vec![0; self.tags.len()];
         self.mesh.tri_tag.iter().for_each(|&t| n[t as usize] += 1);
         n
     }
+}
+
+/// For each medium, the convex solid enclosing it when the fast path is safe: exactly one
+/// closed convex component, and no other triangle and no detector corner inside it.
+fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
+    let mesh = &scene.mesh;
+    let tol = 1e-9 * mesh.bounds().diagonal().max(1.0);
+    (0..scene.media.len())
+        .map(|m| {
+            let encloses = |p: u32| {
+                let tag = mesh.tri_tag[p as usize] as usize;
+                scene.surfaces[tag]
+                    .interface()
+                    .is_some_and(|i| i.inside as usize == m)
+            };
+            let prims: Vec<u32> = (0..mesh.len() as u32).filter(|&p| encloses(p)).collect();
+            if m == 0 || prims.is_empty() {
+                return None;
+            }
+            let solid = ConvexSolid::from_triangles(mesh, &prims, tol)?;
+            let others_inside = (0..mesh.len() as u32).filter(|&p| !encloses(p)).any(|p| {
+                let c = mesh.corners(p);
+                let centroid = (c[0] + c[1] + c[2]) / 3.0;
+                c.iter().chain([&centroid]).any(|&v| solid.contains(v, tol))
+            });
+            let d = &scene.detector;
+            let corners = [0.0, 1.0].map(|a| {
+                [0.0, 1.0].map(|b| d.origin + d.u * (a * d.size[0]) + d.v * (b * d.size[1]))
+            });
+            let detector_inside = corners.iter().flatten().any(|&v| solid.contains(v, tol));
+            (!others_inside && !detector_inside).then_some(solid)
+        })
+        .collect()
 }
 
 /// 64-bit FNV-1a.

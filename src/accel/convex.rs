@@ -1,0 +1,190 @@
+//! The convex-solid fast path: inside a convex light guide, a photon's next surface is
+//! the nearest of a handful of planes, no BVH needed.
+//!
+//! At load, each medium enclosed by exactly one closed, convex mesh component with
+//! nothing else inside it (no other triangle, no detector) gets a [`ConvexSolid`]: its
+//! distinct face planes and, per plane, its triangles. A photon travelling in that medium
+//! then finds its exit by one dot product per plane. Where a plane carries one tag, any of
+//! its triangles is the same surface; where it carries several, the triangle holding the
+//! exit point gives the tag, exactly as a backend's hit would. `blutrace check` reports which media
+//! take this path; `trace --no-convex` turns it off.
+
+use super::Hit;
+use crate::geometry::{Mesh, Ray};
+use glam::DVec3;
+
+/// One face plane of a convex solid: points `p` with `normal · p = offset` (outward normal).
+#[derive(Clone, Debug)]
+struct Plane {
+    normal: DVec3,
+    offset: f64,
+    prims: Vec<u32>,
+    /// True when every triangle of the plane has the same tag: then any of them gives the
+    /// same physics (same tag, same plane), and no point location is needed.
+    one_tag: bool,
+}
+
+/// A closed convex solid as the intersection of its face planes' inner half-spaces.
+#[derive(Clone, Debug)]
+pub struct ConvexSolid {
+    planes: Vec<Plane>,
+    /// Plane normals and offsets packed for the exit loop.
+    normals: Vec<DVec3>,
+    offsets: Vec<f64>,
+}
+
+impl ConvexSolid {
+    /// Build from the triangles `prims` of `mesh` (outward wound, one closed component),
+    /// or `None` if they are not convex within `tol` (mm).
+    pub fn from_triangles(mesh: &Mesh, prims: &[u32], tol: f64) -> Option<ConvexSolid> {
+        let mut planes: Vec<Plane> = Vec::new();
+        for &p in prims {
+            let n = mesh.normal(p);
+            let offset = n.dot(mesh.corners(p)[0]);
+            match planes
+                .iter_mut()
+                .find(|q| q.normal.dot(n) > 1.0 - 1e-12 && (q.offset - offset).abs() <= tol)
+            {
+                Some(q) => q.prims.push(p),
+                None => planes.push(Plane {
+                    normal: n,
+                    offset,
+                    prims: vec![p],
+                    one_tag: true,
+                }),
+            }
+        }
+        for q in &mut planes {
+            let tag = mesh.tri_tag[q.prims[0] as usize];
+            q.one_tag = q.prims.iter().all(|&p| mesh.tri_tag[p as usize] == tag);
+        }
+        let convex = prims
+            .iter()
+            .flat_map(|&p| mesh.corners(p))
+            .all(|v| planes.iter().all(|q| q.normal.dot(v) - q.offset <= tol));
+        let normals = planes.iter().map(|q| q.normal).collect();
+        let offsets = planes.iter().map(|q| q.offset).collect();
+        (convex && planes.len() >= 4).then_some(ConvexSolid {
+            planes,
+            normals,
+            offsets,
+        })
+    }
+
+    /// Number of distinct face planes.
+    pub fn plane_count(&self) -> usize {
+        self.planes.len()
+    }
+
+    /// True when `p` lies strictly inside (deeper than `tol` from every plane).
+    pub fn contains(&self, p: DVec3, tol: f64) -> bool {
+        self.planes
+            .iter()
+            .all(|q| q.normal.dot(p) - q.offset < -tol)
+    }
+
+    /// Where a ray starting inside leaves the solid: nearest plane ahead, and the
+    /// triangle of that plane holding the exit point.
+    pub fn exit(&self, mesh: &Mesh, ray: &Ray) -> Option<Hit> {
+        let (mut t, mut best) = (f64::INFINITY, usize::MAX);
+        for (i, (n, offset)) in self.normals.iter().zip(&self.offsets).enumerate() {
+            let denom = n.dot(ray.dir);
+            if denom > 0.0 {
+                let ti = ((offset - n.dot(ray.origin)) / denom).max(0.0);
+                if ti < t {
+                    (t, best) = (ti, i);
+                }
+            }
+        }
+        let plane = self.planes.get(best)?;
+        if plane.one_tag {
+            return Some(Hit {
+                t,
+                prim: plane.prims[0],
+            });
+        }
+        let point = ray.at(t);
+        let prim = plane.prims.iter().copied().min_by(|&a, &b| {
+            outside_distance(mesh, a, point).total_cmp(&outside_distance(mesh, b, point))
+        })?;
+        Some(Hit { t, prim })
+    }
+}
+
+/// How far `p` (on the triangle's plane) lies outside triangle `prim`: 0 when inside.
+fn outside_distance(mesh: &Mesh, prim: u32, p: DVec3) -> f64 {
+    let [a, b, c] = mesh.corners(prim);
+    let n = (b - a).cross(c - a);
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(u, v)| {
+            let edge_normal = (v - u).cross(n).normalize_or_zero();
+            edge_normal.dot(p - u).max(0.0)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Accel, brute::BruteForce};
+    use std::sync::Arc;
+
+    /// A unit cube wound outward.
+    fn cube() -> Mesh {
+        let positions = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let quads = [
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+        ];
+        let triangles: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let tri_tag = vec![0; triangles.len()];
+        Mesh {
+            positions,
+            triangles,
+            tri_tag,
+        }
+    }
+
+    #[test]
+    fn cube_is_convex_and_exits_match_brute_force() {
+        let mesh = cube();
+        let prims: Vec<u32> = (0..12).collect();
+        let solid = ConvexSolid::from_triangles(&mesh, &prims, 1e-9).expect("a cube is convex");
+        assert_eq!(solid.plane_count(), 6);
+        let brute = BruteForce::new(Arc::new(mesh.clone()));
+        let mut rng = crate::rng::PhotonRng::new(1, 0);
+        for _ in 0..10_000 {
+            let o = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 0.98 + 0.01;
+            let d = crate::optics::sampling::around(
+                DVec3::Z,
+                2.0 * rng.uniform() - 1.0,
+                6.283 * rng.uniform(),
+            );
+            let ray = Ray::new(o, d);
+            let a = solid.exit(&mesh, &ray).unwrap();
+            let b = brute.intersect(&ray, f64::INFINITY).unwrap();
+            assert!((a.t - b.t).abs() < 1e-12, "{a:?} vs {b:?}");
+            // One tag per face: any triangle of the exit plane is the same surface.
+            assert_eq!(mesh.normal(a.prim), mesh.normal(b.prim));
+        }
+    }
+
+    #[test]
+    fn a_notched_solid_is_not_convex() {
+        let mut mesh = cube();
+        // Push one corner inward: the faces around it are no longer planar/convex.
+        mesh.positions[7] = DVec3::new(0.6, 0.6, 0.6);
+        let prims: Vec<u32> = (0..12).collect();
+        assert!(ConvexSolid::from_triangles(&mesh, &prims, 1e-9).is_none());
+    }
+}

@@ -97,6 +97,14 @@ impl TargetPlane {
         (t0.cos() - t1.cos()) * TAU / np as f64
     }
 
+    /// Projected solid angle (sr, the integral of cos theta) of one bin in row `it`.
+    pub fn angular_bin_projected_solid_angle(&self, it: usize) -> f64 {
+        let [nt, np] = self.angular_bins;
+        let t0 = FRAC_PI_2 * it as f64 / nt as f64;
+        let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
+        0.5 * (t1.sin().powi(2) - t0.sin().powi(2)) * TAU / np as f64
+    }
+
     /// Empty flux and angular grids for this detector.
     pub fn empty_grids(&self) -> (Grid, Grid) {
         (
@@ -139,5 +147,9 @@ mod tests {
         let p = plane();
         let total: f64 = (0..9).map(|it| p.angular_bin_solid_angle(it) * 12.0).sum();
         assert!((total - TAU).abs() < 1e-12);
+        let projected: f64 = (0..9)
+            .map(|it| p.angular_bin_projected_solid_angle(it) * 12.0)
+            .sum();
+        assert!((projected - std::f64::consts::PI).abs() < 1e-12);
     }
 }

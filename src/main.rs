@@ -238,6 +238,12 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {:.3e} ({:?})",
         s.mean_rel_stderr, s.figure_of_merit.efficiency, s.figure_of_merit.metric
     );
+    if let Some(lum) = &s.luminance {
+        println!(
+            "luminance  on-axis {:.1} ± {:.1} cd/m² (sources at {:.0} lm/W)",
+            lum.on_axis_cd_m2, lum.on_axis_stderr_cd_m2, lum.efficacy_lm_per_w
+        );
+    }
     for f in files {
         println!("wrote      {}", f.display());
     }

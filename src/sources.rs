@@ -18,6 +18,7 @@
 //! width_mm = 3.0
 //! height_mm = 0.6
 //! power_w = 0.1
+//! lumens = 30.0              # optional: luminous flux, for luminance outputs
 //! cos_exponent = 1.0         # 1 = Lambertian
 //! ```
 
@@ -66,6 +67,8 @@ pub struct Source {
     pub name: String,
     /// Radiant power (W).
     pub power_w: f64,
+    /// Luminous flux (lm), when the scene gives it.
+    pub lumens: Option<f64>,
     /// Shape and angular profile.
     pub emitter: Emitter,
     /// Medium the source emits into.
@@ -148,6 +151,12 @@ impl Sources {
         }
     }
 
+    /// Luminous efficacy of the radiation (lm/W) when every source gives its lumens.
+    pub fn luminous_efficacy(&self) -> Option<f64> {
+        let lumens: Option<f64> = self.list.iter().map(|s| s.lumens).sum();
+        lumens.map(|lm| lm / self.total_power())
+    }
+
     /// Total radiant power (W).
     pub fn total_power(&self) -> f64 {
         self.list.iter().map(|s| s.power_w).sum()
@@ -174,6 +183,7 @@ mod tests {
         let s = Source {
             name: "t".into(),
             power_w: 1.0,
+            lumens: None,
             emitter: Emitter::Ccfl {
                 center: DVec3::new(1.0, 2.0, 3.0),
                 axis: DVec3::Y,
@@ -198,6 +208,7 @@ mod tests {
         let led = |p: f64| Source {
             name: "l".into(),
             power_w: p,
+            lumens: None,
             emitter: Emitter::Led {
                 center: DVec3::ZERO,
                 normal: DVec3::Z,

@@ -42,10 +42,45 @@ pub fn flux_map(scene: &Scene, t: &Tally) -> Map {
 /// Radiant intensity (W/sr) per (theta, phi) bin; x = phi, y = theta.
 pub fn angular_map(scene: &Scene, t: &Tally) -> Map {
     let g = &t.angular;
-    let by_theta = grid_map(scene, t, g, |i| {
+    phi_fastest(grid_map(scene, t, g, |i| {
         scene.detector.angular_bin_solid_angle(i % g.nx)
+    }))
+}
+
+/// Luminance (cd/m^2) averaged over the target, per (theta, phi) bin; x = phi, y = theta.
+/// Needs the sources' lumens; `None` otherwise. L = K P / (A * projected solid angle).
+pub fn luminance_map(scene: &Scene, t: &Tally) -> Option<Map> {
+    let efficacy = scene.sources.luminous_efficacy()?;
+    let d = &scene.detector;
+    let area_m2 = d.size[0] * d.size[1] * 1e-6;
+    let g = &t.angular;
+    let m = grid_map(scene, t, g, |i| {
+        d.angular_bin_projected_solid_angle(i % g.nx) * area_m2 / efficacy
     });
-    let (nt, np) = (g.nx, g.ny);
+    Some(phi_fastest(m))
+}
+
+/// Luminance (cd/m^2) per theta row, averaged over phi: (theta centre in degrees, value,
+/// standard error). Each photon lands in one bin, so row sums of squares are exact.
+pub fn luminance_by_theta(scene: &Scene, t: &Tally) -> Option<Vec<[f64; 3]>> {
+    let efficacy = scene.sources.luminous_efficacy()?;
+    let d = &scene.detector;
+    let area_m2 = d.size[0] * d.size[1] * 1e-6;
+    let (nt, np) = (t.angular.nx, t.angular.ny);
+    let watts = scene.sources.total_power();
+    let rows = (0..nt).map(|it| {
+        let mut row = crate::tally::BinStats::default();
+        (0..np).for_each(|ip| row.merge(&t.angular.bins[ip * nt + it]));
+        let (mean, se) = row.mean_and_stderr(t.ledger.photons);
+        let k = watts * efficacy / (area_m2 * d.angular_bin_projected_solid_angle(it) * np as f64);
+        [90.0 * (it as f64 + 0.5) / nt as f64, mean * k, se * k]
+    });
+    Some(rows.collect())
+}
+
+/// Re-order a (theta fastest) angular grid map so that phi runs fastest.
+fn phi_fastest(by_theta: Map) -> Map {
+    let (nt, np) = (by_theta.nx, by_theta.ny);
     let mut m = Map {
         nx: np,
         ny: nt,

@@ -14,7 +14,8 @@
 //! Outputs written by [`RunResult::write`]:
 //! - `flux.exr`: channels `flux` (W/mm^2 per bin), `flux_stderr`, `hits`;
 //! - `angular.exr`: channels `intensity` (W/sr per (theta, phi) bin), `intensity_stderr`,
-//!   `hits`; x = phi, y = theta;
+//!   `hits`, and `luminance`, `luminance_stderr` (cd/m^2 averaged over the target) when
+//!   the sources give their lumens; x = phi, y = theta;
 //! - `flux.png`: false-colour preview of the flux map;
 //! - `convergence.csv`, `convergence.png`: metrics and errors against photons and time;
 //! - `summary.json`: run facts, energy ledger, uniformity and errors.
@@ -387,13 +388,8 @@ impl RunResult<'_> {
             common[0],
             common[1],
         ];
-        write_map_exr(
-            &mut staged,
-            "angular.exr",
-            &ang,
-            ["intensity", "intensity_stderr"],
-            &ang_attrs,
-        )?;
+        let lum = metrics::luminance_map(self.scene, &self.tally);
+        write_angular_exr(&mut staged, &ang, lum.as_ref(), &ang_attrs)?;
         let png = staged.stage_path("flux.png");
         output::png::write_false_colour(
             &png,
@@ -412,6 +408,29 @@ impl RunResult<'_> {
         staged.write_bytes("summary.json", &json)?;
         staged.commit()
     }
+}
+
+/// angular.exr: intensity (W/sr), and luminance (cd/m^2) when the sources give lumens.
+fn write_angular_exr(
+    staged: &mut StagedDir,
+    ang: &Map,
+    lum: Option<&Map>,
+    attrs: &[(&str, f64)],
+) -> Result<()> {
+    let f = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let hits: Vec<f32> = ang.hits.iter().map(|&h| h as f32).collect();
+    let (i, ie) = (f(&ang.value), f(&ang.stderr));
+    let mut channels: Vec<(&str, &[f32])> = vec![
+        ("intensity", &i),
+        ("intensity_stderr", &ie),
+        ("hits", &hits),
+    ];
+    let (l, le) = lum.map_or((Vec::new(), Vec::new()), |m| (f(&m.value), f(&m.stderr)));
+    if lum.is_some() {
+        channels.extend([("luminance", &l[..]), ("luminance_stderr", &le[..])]);
+    }
+    let path = staged.stage_path("angular.exr");
+    output::exr::write_channels(&path, ang.nx, ang.ny, &channels, attrs)
 }
 
 fn write_map_exr(

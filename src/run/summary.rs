@@ -55,6 +55,8 @@ pub struct Summary {
     pub mean_rel_stderr: f64,
     /// Monte Carlo efficiency of the run.
     pub figure_of_merit: FigureOfMerit,
+    /// Luminance, when the sources give their lumens.
+    pub luminance: Option<LuminanceSummary>,
     /// Detector geometry.
     pub detector: DetectorSummary,
     /// Scene-loading warnings.
@@ -71,6 +73,19 @@ pub struct FigureOfMerit {
     pub rel_error: f64,
     /// `1 / (rel_error^2 * runtime_s)`.
     pub efficiency: f64,
+}
+
+/// Luminance of the target (cd/m^2, averaged over its area) against viewing angle.
+#[derive(Clone, Debug, Serialize)]
+pub struct LuminanceSummary {
+    /// Luminous efficacy of the sources (lm/W), total lumens over total watts.
+    pub efficacy_lm_per_w: f64,
+    /// On-axis luminance: the first theta row.
+    pub on_axis_cd_m2: f64,
+    /// Its standard error.
+    pub on_axis_stderr_cd_m2: f64,
+    /// Rows of [theta centre (deg), luminance (cd/m^2), standard error], averaged over phi.
+    pub by_theta: Vec<[f64; 3]>,
 }
 
 /// The energy ledger in watts.
@@ -179,6 +194,14 @@ impl RunResult<'_> {
                 rel_error: rel,
                 efficiency: 1.0 / (rel * rel * runtime),
             },
+            luminance: super::metrics::luminance_by_theta(self.scene, &self.tally).map(|rows| {
+                LuminanceSummary {
+                    efficacy_lm_per_w: self.scene.sources.luminous_efficacy().unwrap_or(f64::NAN),
+                    on_axis_cd_m2: rows[0][1],
+                    on_axis_stderr_cd_m2: rows[0][2],
+                    by_theta: rows,
+                }
+            }),
             detector: DetectorSummary {
                 size_mm: d.size,
                 bins: d.bins,

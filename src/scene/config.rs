@@ -186,6 +186,8 @@ pub enum SourceSpec {
         length_mm: f64,
         /// Radiant power (W).
         power_w: f64,
+        /// Luminous flux (lm), for luminance outputs.
+        lumens: Option<f64>,
         /// Medium around the tube.
         #[serde(default = "air")]
         medium: String,
@@ -206,6 +208,8 @@ pub enum SourceSpec {
         height_mm: f64,
         /// Radiant power (W).
         power_w: f64,
+        /// Luminous flux (lm), for luminance outputs.
+        lumens: Option<f64>,
         /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere).
         #[serde(default = "one")]
         cos_exponent: f64,

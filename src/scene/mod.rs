@@ -618,10 +618,12 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 radius_mm,
                 length_mm,
                 power_w,
+                lumens,
                 medium,
             } => Source {
                 name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
                 power_w: ctx.positive(&f("power_w"), *power_w)?,
+                lumens: optional_positive(ctx, &f("lumens"), *lumens)?,
                 emitter: Emitter::Ccfl {
                     center: ctx.point(&f("center"), *center)?,
                     axis: ctx.direction(&f("axis"), *axis)?,
@@ -638,6 +640,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 width_mm,
                 height_mm,
                 power_w,
+                lumens,
                 cos_exponent,
                 medium,
             } => {
@@ -649,6 +652,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 Source {
                     name: name.clone().unwrap_or_else(|| format!("led{i}")),
                     power_w: ctx.positive(&f("power_w"), *power_w)?,
+                    lumens: optional_positive(ctx, &f("lumens"), *lumens)?,
                     emitter: Emitter::Led {
                         center: ctx.point(&f("center"), *center)?,
                         normal: n,
@@ -663,6 +667,10 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
         });
     }
     Ok(Sources::new(list))
+}
+
+fn optional_positive(ctx: &Ctx, field: &str, x: Option<f64>) -> Result<Option<f64>> {
+    x.map(|v| ctx.positive(field, v)).transpose()
 }
 
 fn build_detector(ctx: &Ctx, d: &DetectorSpec) -> Result<TargetPlane> {

@@ -113,7 +113,8 @@ Not given by the paper, chosen as typical (lengths in mm):
   Tags lgp_front (z = {T}), lgp_back (z = 0, ink dots), lgp_edge (the four sides).
 - Ink dots: hex lattice, pitch {DOT_PITCH}, constant density {DOT_DENSITY} (area fraction), ink albedo
   {INK_ALBEDO}; mirrored about x = {half} since lamps light both x edges.
-- CCFLs: radius {LAMP_R}, length {W} (the guide's y extent), 1 W each, centres at
+- CCFLs: radius {LAMP_R}, length {W} (the guide's y extent), 1 W and 300 lm each
+  (300 lm/W: a typical tri-phosphor white spectrum), centres at
   x = {xl} (left) and {xr} (right), y = {yc}, z = {zlo} and {zhi} (stacked in z, {tube_gap}
   apart): {air} of air between a tube and the guide's edge face.
 - Lamp reflectors (tag lamp_reflector): a circular arc of radius {r} about
@@ -208,6 +209,7 @@ axis = [0.0, 1.0, 0.0]
 radius_mm = {}
 length_mm = {}
 power_w = 1.0
+lumens = 300.0
 ",
             arr(&c),
             num(LAMP_R),

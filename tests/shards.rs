@@ -8,11 +8,10 @@ const SCENE: &str = "scenes/notebook14";
 const PHOTONS: &str = "150000";
 
 fn blutrace(args: &[&str]) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+    Command::new(env!("CARGO_BIN_EXE_blutrace"))
         .args(args)
         .output()
-        .expect("run blutrace");
-    out
+        .expect("run blutrace")
 }
 
 fn ok(args: &[&str]) {

@@ -15,7 +15,8 @@
 # one is replaced.
 #
 # Usage: bash tools/fetch-embree.sh [--force]
-# Needs: python3 with pip, and access to PyPI. Exits non-zero on any failure.
+# Needs: python3 with pip (installed with apt-get when run as root on Debian), and access
+# to PyPI. Exits non-zero on any failure.
 set -euo pipefail
 
 WHEEL_VERSION="4.4.0.post1"
@@ -65,6 +66,14 @@ if [[ $force -eq 0 ]] && installed_ok; then
 fi
 
 PYTHON="${PYTHON:-python3}"
+# A fresh Debian machine may have neither Python nor pip: as root, install them.
+if ! { command -v "$PYTHON" >/dev/null && "$PYTHON" -m pip --version >/dev/null 2>&1; } &&
+    [[ "$(id -u)" == 0 ]] && command -v apt-get >/dev/null; then
+    echo "fetch-embree: installing python3-pip with apt-get (needed to fetch the Embree wheel)..."
+    DEBIAN_FRONTEND=noninteractive apt-get update -qq &&
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-pip >/dev/null ||
+        die "apt-get could not install python3-pip"
+fi
 command -v "$PYTHON" >/dev/null ||
     die "$PYTHON not found: install Python 3 with pip (e.g. apt-get install python3-pip), or put libembree4.so.4 (4.4.x) somewhere and set BLUTRACE_EMBREE to it"
 "$PYTHON" -m pip --version >/dev/null 2>&1 ||

@@ -168,7 +168,7 @@ mod tests {
             let d = crate::optics::sampling::around(
                 DVec3::Z,
                 2.0 * rng.uniform() - 1.0,
-                6.283 * rng.uniform(),
+                std::f64::consts::TAU * rng.uniform(),
             );
             let ray = Ray::new(o, d);
             let a = solid.exit(&mesh, &ray).unwrap();

@@ -28,7 +28,7 @@ impl TaggedTriangles {
         tag: &str,
         file: &Path,
     ) -> Result<()> {
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             bail!(
                 "{}: tag '{tag}': index count {} is not a multiple of 3",
                 file.display(),

@@ -5,7 +5,7 @@ use blutrace::accel::BackendChoice;
 use blutrace::run::{self, RunOptions, RunResult};
 use blutrace::scene::Scene;
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// OBJ text for an axis-aligned box with one tag per face, in the order
 /// -x, +x, -y, +y, -z, +z. Faces are wound outward.
@@ -51,7 +51,7 @@ pub fn write_scene(name: &str, toml: &str, files: &[(&str, &str)]) -> PathBuf {
 }
 
 /// Load a scene written by [`write_scene`], panicking with the loader's message.
-pub fn load(path: &PathBuf) -> Scene {
+pub fn load(path: &Path) -> Scene {
     Scene::load(path).unwrap_or_else(|e| panic!("{e:#}"))
 }
 

@@ -53,6 +53,8 @@ pub struct ShardFile {
     pub backend: String,
     /// Tracing seconds.
     pub runtime_s: f64,
+    /// Worker threads the shard used.
+    pub threads: usize,
     /// Per-group tallies (their sum is the shard's tally).
     pub groups: Vec<Tally>,
 }
@@ -75,6 +77,7 @@ pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
         estimator: o.estimator,
         backend: result.backend.to_string(),
         runtime_s: result.runtime_s,
+        threads: result.threads,
         groups: result.groups.clone(),
     };
     let mut staged = StagedDir::new(dir)?;
@@ -220,7 +223,8 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
             estimator: first.estimator,
             ..RunOptions::default()
         },
-        threads: 0,
+        // All worker threads of all shards; runtime_s likewise sums the shards' times.
+        threads: shards.iter().map(|(_, s)| s.threads).sum(),
         tally: total,
         groups,
         runtime_s,

@@ -3,8 +3,20 @@ use blutrace::run::{self, RunOptions};
 use blutrace::scene::Scene;
 fn main() -> anyhow::Result<()> {
     let a: Vec<String> = std::env::args().collect();
-    let scene = Scene::load(std::path::Path::new(&a[1]))?;
+    let mut scene = Scene::load(std::path::Path::new(&a[1]))?;
+    if a.len() > 3 {
+        let c: Vec<f64> = a[3].split(',').map(|v| v.parse().unwrap()).collect();
+        for s in &mut scene.surfaces {
+            if let blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } = s {
+                pattern.density = blutrace::optics::dots::Density::Polynomial(c.clone());
+            }
+        }
+    }
     let n: u64 = a[2].parse()?;
+    if let Ok(t) = std::env::var("ABSORB_TAG") {
+        let i = scene.tags.iter().position(|x| *x == t).unwrap();
+        scene.surfaces[i] = blutrace::optics::surface::SurfaceModel::Absorber;
+    }
     let r = run::trace(
         &scene,
         &RunOptions {
@@ -25,6 +37,7 @@ fn main() -> anyhow::Result<()> {
         r.runtime_s
     );
     let u = Uniformity::of(&m);
+    println!("abs mean {:.4e}", u.mean);
     let mut px = vec![0.0; m.nx];
     for y in 0..m.ny {
         for x in 0..m.nx {

@@ -10,6 +10,7 @@ pub mod bench;
 pub mod detector;
 pub mod geometry;
 pub mod optics;
+pub mod optimize;
 pub mod output;
 pub mod rng;
 pub mod run;

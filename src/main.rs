@@ -26,6 +26,8 @@ enum Command {
     Trace(TraceArgs),
     /// Merge shard runs (`trace --shard K/M`) into the outputs of one run.
     Merge(MergeArgs),
+    /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback).
+    Optimize(blutrace::optimize::cli::OptimizeArgs),
     /// Measure photons/s per backend (ratios in one run; see the README's table).
     Bench {
         /// Photons per configuration.
@@ -120,6 +122,7 @@ impl Command {
         match self {
             Command::Trace(args) => trace(args),
             Command::Merge(args) => merge(args),
+            Command::Optimize(args) => blutrace::optimize::cli::run(args),
             Command::Bench {
                 photons,
                 threads,

@@ -20,14 +20,22 @@
 //! power_w = 0.1
 //! lumens = 30.0              # optional: luminous flux, for luminance outputs
 //! cos_exponent = 1.0         # 1 = Lambertian
+//! # intensity_file = "led.ies"  # instead of cos_exponent: a measured I(theta) table
 //! ```
+//!
+//! An LED with `intensity_file` becomes an [`Emitter::MeasuredLed`]; see [`intensity`]
+//! for the CSV and IES LM-63 formats and how the table is sampled.
+
+pub mod intensity;
 
 use crate::geometry::{Ray, orthonormal_basis};
 use crate::optics::sampling;
 use crate::optics::surface::MediumId;
 use crate::rng::PhotonRng;
 use glam::DVec3;
+use intensity::IntensityProfile;
 use std::f64::consts::TAU;
+use std::sync::Arc;
 
 /// The emitting shape of a source.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,6 +66,21 @@ pub enum Emitter {
         /// Exponent m of the cos^m profile.
         cos_exponent: f64,
     },
+    /// Flat rectangle with a measured, rotationally symmetric intensity profile.
+    MeasuredLed {
+        /// Centre of the rectangle.
+        center: DVec3,
+        /// Unit emitting normal.
+        normal: DVec3,
+        /// Unit width direction (in the plane).
+        u: DVec3,
+        /// Width along `u` (mm).
+        width: f64,
+        /// Height along `normal x u` (mm).
+        height: f64,
+        /// Relative intensity by angle from the normal.
+        profile: Arc<IntensityProfile>,
+    },
 }
 
 /// One source.
@@ -79,7 +102,9 @@ impl Source {
     /// The centre of the emitter.
     pub fn anchor(&self) -> DVec3 {
         match &self.emitter {
-            Emitter::Ccfl { center, .. } | Emitter::Led { center, .. } => *center,
+            Emitter::Ccfl { center, .. }
+            | Emitter::Led { center, .. }
+            | Emitter::MeasuredLed { center, .. } => *center,
         }
     }
 
@@ -115,6 +140,22 @@ impl Source {
                 let d = sampling::cos_power(*normal, *cos_exponent, rng.uniform(), rng.uniform());
                 Ray::new(p, d)
             }
+            Emitter::MeasuredLed {
+                center,
+                normal,
+                u,
+                width,
+                height,
+                profile,
+            } => {
+                let v = normal.cross(*u);
+                let p = *center
+                    + *u * ((rng.uniform() - 0.5) * width)
+                    + v * ((rng.uniform() - 0.5) * height);
+                let theta = profile.sample_theta(rng.uniform());
+                let d = sampling::around(*normal, theta.cos(), TAU * rng.uniform());
+                Ray::new(p, d)
+            }
         }
     }
 }
@@ -146,7 +187,9 @@ impl Sources {
     pub fn translate(&mut self, d: DVec3) {
         for s in &mut self.list {
             match &mut s.emitter {
-                Emitter::Ccfl { center, .. } | Emitter::Led { center, .. } => *center += d,
+                Emitter::Ccfl { center, .. }
+                | Emitter::Led { center, .. }
+                | Emitter::MeasuredLed { center, .. } => *center += d,
             }
         }
     }

@@ -16,9 +16,10 @@ const SCALE: f64 = 18446744073709551616.0; // 2^64
 pub struct ExactSum(pub i128);
 
 impl ExactSum {
-    /// Add one contribution (rounded to the nearest multiple of 2^-64).
+    /// Add one contribution (rounded to the nearest multiple of 2^-64, ties to even, so
+    /// rounding has no bias).
     pub fn add(&mut self, x: f64) {
-        self.0 += (x * SCALE).round() as i128;
+        self.0 += (x * SCALE).round_ties_even() as i128;
     }
 
     /// Add another exact sum.

@@ -20,6 +20,7 @@ use crate::optics::surface::{Estimator, MediumId, Outcome};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{BinStats, ExactSum, Grid};
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -220,6 +221,10 @@ pub struct Tracer<'a> {
 
 /// A photon in flight.
 struct Photon {
+    /// Where the photon really is (on the surface it last left).
+    pos: DVec3,
+    /// Its search ray: from `pos` along its direction, nudged off that surface by the
+    /// scene's spawn offset so single-precision backends do not re-hit it.
     ray: Ray,
     medium: MediumId,
     weight: f64,
@@ -231,6 +236,7 @@ impl Tracer<'_> {
         let mut rng = PhotonRng::new(seed, index);
         let (ray, medium) = self.scene.sources.sample(&mut rng);
         let mut p = Photon {
+            pos: ray.origin,
             ray,
             medium,
             weight: 1.0,
@@ -245,12 +251,20 @@ impl Tracer<'_> {
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
         for _ in 0..scene.max_bounces {
-            let hit = match scene.convex_solid(p.medium).filter(|_| self.convex) {
-                Some(solid) => solid.exit(&scene.mesh, &p.ray),
-                None => self.accel.intersect(&p.ray, f64::INFINITY),
+            // Distances are measured from the true position, so spawn nudges never
+            // accumulate over thousands of bounces in a thin guide.
+            let true_ray = Ray::new(p.pos, p.ray.dir);
+            let surf = match scene.convex_solid(p.medium).filter(|_| self.convex) {
+                Some(solid) => solid
+                    .exit(&scene.mesh, &true_ray)
+                    .map(|h| scene.mesh.refine_hit(&true_ray, h.prim, h.t)),
+                None => self
+                    .accel
+                    .intersect(&p.ray, f64::INFINITY)
+                    .map(|h| scene.mesh.refine_hit_from(p.pos, &p.ray, h.prim, h.t)),
             };
-            let t_surface = hit.map_or(f64::INFINITY, |h| h.t);
-            let detected = scene.detector.intersect(&p.ray, t_surface);
+            let t_surface = surf.map_or(f64::INFINITY, |h| h.t);
+            let detected = scene.detector.intersect(&true_ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
             if !self.cross_medium(p, t_next, rng, &mut out.ledger) {
                 return Fate::AbsorbedInMedium(p.medium);
@@ -260,12 +274,11 @@ impl Tracer<'_> {
                     .push(detection(scene, ab, p.ray.dir, p.weight));
                 return Fate::Detected;
             }
-            let Some(h) = hit else {
+            let Some(surf) = surf else {
                 return Fate::Escaped;
             };
             out.ledger.interactions += 1;
-            let surf = scene.mesh.refine_hit(&p.ray, h.prim, h.t);
-            let tag = scene.mesh.tri_tag[h.prim as usize];
+            let tag = scene.mesh.tri_tag[surf.prim as usize];
             let model = &scene.surfaces[tag as usize];
             match model.interact(
                 &scene.media,
@@ -288,6 +301,7 @@ impl Tracer<'_> {
                         w,
                     );
                     p.weight = w;
+                    p.pos = surf.point;
                     p.ray = Ray::new(scene.spawn_point(surf.point, surf.normal, dir), dir);
                     p.medium = medium;
                 }

@@ -18,6 +18,14 @@
 //! x_unit = "normalized"      # x in [0, 1] ("mm": x in millimetres)
 //! mirror = true              # lamps on both edges: x measured from the nearer edge
 //! ```
+//!
+//! Instead of `density`, a tabulated density (what `blutrace optimize --method feedback`
+//! writes) gives knots `[x, d]` with `x` increasing, in the same unit as the polynomial's
+//! variable; `d` is linear between knots and constant beyond the first and last:
+//!
+//! ```toml
+//! density_table = [[0.0, 0.02], [0.5, 0.2], [1.0, 0.6]]
+//! ```
 
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -67,6 +75,70 @@ pub enum XUnit {
     Mm,
 }
 
+/// The density function d(x): the area fraction of a cell covered by its dot.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Density {
+    /// Polynomial coefficients, lowest degree first: `d(x) = c0 + c1 x + c2 x^2 + ...`.
+    Polynomial(Vec<f64>),
+    /// Knots `[x, d]`, `x` strictly increasing: linear between knots, constant beyond
+    /// the first and the last.
+    Table(Vec<[f64; 2]>),
+}
+
+impl Density {
+    /// The density at the polynomial variable `x`.
+    pub fn eval(&self, x: f64) -> f64 {
+        match self {
+            Density::Polynomial(c) => c.iter().rev().fold(0.0, |acc, c| acc * x + c),
+            Density::Table(knots) => interpolate(knots, x),
+        }
+    }
+
+    /// Why this density cannot be used (empty, non-finite, knots not increasing), if so.
+    pub fn problem(&self) -> Option<String> {
+        match self {
+            Density::Polynomial(c) if c.is_empty() => Some("needs at least one coefficient".into()),
+            Density::Polynomial(c) => c
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|i| format!("coefficient {i} is not a finite number")),
+            Density::Table(k) if k.is_empty() => Some("needs at least one knot".into()),
+            Density::Table(k) => {
+                if let Some(i) = k
+                    .iter()
+                    .position(|p| !p[0].is_finite() || !p[1].is_finite())
+                {
+                    return Some(format!("knot {i} is not a pair of finite numbers"));
+                }
+                k.windows(2).position(|w| w[1][0] <= w[0][0]).map(|i| {
+                    format!(
+                        "knot x values must increase strictly (knots {i} and {})",
+                        i + 1
+                    )
+                })
+            }
+        }
+    }
+}
+
+/// Piecewise-linear interpolation through `knots` (x increasing), constant outside.
+fn interpolate(knots: &[[f64; 2]], x: f64) -> f64 {
+    let Some(first) = knots.first() else {
+        return 0.0;
+    };
+    let last = knots[knots.len() - 1];
+    if x <= first[0] {
+        return first[1];
+    }
+    if x >= last[0] {
+        return last[1];
+    }
+    // First knot strictly right of x; exists and is > 0 because first[0] < x < last[0].
+    let i = knots.partition_point(|k| k[0] <= x);
+    let (a, b) = (knots[i - 1], knots[i]);
+    a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0])
+}
+
 /// A dot pattern placed on a face.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DotPattern {
@@ -82,8 +154,8 @@ pub struct DotPattern {
     pub across: DVec3,
     /// Span along `axis` covered by the pattern (mm).
     pub length: f64,
-    /// Polynomial coefficients, lowest degree first.
-    pub density: Vec<f64>,
+    /// The density function of the polynomial variable.
+    pub density: Density,
     /// Unit of the polynomial variable.
     pub x_unit: XUnit,
     /// Measure from the nearer of the two edges (lamps on both ends).
@@ -107,8 +179,17 @@ impl DotPattern {
 
     /// The density (area fraction) at distance `u` (mm) along the axis.
     pub fn density_at(&self, u: f64) -> f64 {
-        let x = self.x_of(u);
-        self.density.iter().rev().fold(0.0, |acc, c| acc * x + c)
+        self.density.eval(self.x_of(u))
+    }
+
+    /// The polynomial variable at the far end of the span (1 when normalized, else the
+    /// span in mm: the length, or half of it when mirrored).
+    pub fn x_max(&self) -> f64 {
+        self.x_of(if self.mirror {
+            0.5 * self.length
+        } else {
+            self.length
+        })
     }
 
     /// Check that the density is finite and within `[0, max packing]` along the whole
@@ -122,8 +203,36 @@ impl DotPattern {
             .find(|&(_, d)| !d.is_finite() || !(0.0..=max).contains(&d))
     }
 
+    /// Distance (mm) between lattice rows: the pitch for square cells, `pitch sqrt(3)/2`
+    /// for hex cells.
+    pub fn row_spacing(&self) -> f64 {
+        match self.lattice {
+            Lattice::Square => self.pitch,
+            Lattice::Hex => 0.5 * 3f64.sqrt() * self.pitch,
+        }
+    }
+
+    /// Centre of cell `i` of row `j` in face coordinates (mm along `axis`, mm along
+    /// `across`, from `origin`); hex rows of odd `j` are shifted by half a pitch.
+    pub fn cell_centre(&self, i: i64, j: i64) -> DVec2 {
+        let p = self.pitch;
+        let shift = match self.lattice {
+            Lattice::Hex if j.rem_euclid(2) == 1 => 0.5 * p,
+            _ => 0.0,
+        };
+        DVec2::new(
+            (i as f64 + 0.5) * p + shift,
+            (j as f64 + 0.5) * self.row_spacing(),
+        )
+    }
+
+    /// Radius (mm) of the dot centred at face coordinate `u` along the axis.
+    pub fn dot_radius_at(&self, u: f64) -> f64 {
+        self.lattice.dot_radius(self.pitch, self.density_at(u))
+    }
+
     /// In-face lattice coordinates of a point (mm along `axis`, mm along `across`).
-    fn face_coords(&self, p: DVec3) -> DVec2 {
+    pub fn face_coords(&self, p: DVec3) -> DVec2 {
         let r = p - self.origin;
         DVec2::new(r.dot(self.axis), r.dot(self.across))
     }
@@ -174,7 +283,7 @@ mod tests {
             axis: DVec3::X,
             across: DVec3::Y,
             length: 100.0,
-            density: vec![density],
+            density: Density::Polynomial(vec![density]),
             x_unit: XUnit::Normalized,
             mirror: false,
         }
@@ -207,7 +316,7 @@ mod tests {
     #[test]
     fn mirror_measures_from_nearer_edge() {
         let mut p = pattern(Lattice::Square, 0.0);
-        p.density = vec![0.0, 1.0];
+        p.density = Density::Polynomial(vec![0.0, 1.0]);
         p.mirror = true;
         assert!((p.x_of(10.0) - 0.2).abs() < 1e-12);
         assert!((p.x_of(90.0) - 0.2).abs() < 1e-12);
@@ -215,13 +324,51 @@ mod tests {
     }
 
     #[test]
+    fn table_interpolates_linearly_and_clamps() {
+        let d = Density::Table(vec![[0.0, 0.1], [0.5, 0.3], [1.0, 0.2]]);
+        assert_eq!(d.eval(-1.0), 0.1);
+        assert!((d.eval(0.25) - 0.2).abs() < 1e-12);
+        assert!((d.eval(0.75) - 0.25).abs() < 1e-12);
+        assert_eq!(d.eval(0.5), 0.3);
+        assert_eq!(d.eval(3.0), 0.2);
+        assert_eq!(d.problem(), None);
+        assert!(
+            Density::Table(vec![[0.0, 0.1], [0.0, 0.2]])
+                .problem()
+                .is_some()
+        );
+        assert!(Density::Table(vec![]).problem().is_some());
+        assert!(Density::Polynomial(vec![f64::NAN]).problem().is_some());
+        let mut p = pattern(Lattice::Square, 0.0);
+        p.density = Density::Table(vec![[0.0, 0.05], [1.0, 0.65]]);
+        let got = coverage(&p); // patch x 20..30 of 100: mean x = 0.25
+        assert!((got - 0.2).abs() < 0.01, "covered {got}");
+    }
+
+    #[test]
+    fn cell_centres_are_lattice_points() {
+        for lattice in [Lattice::Square, Lattice::Hex] {
+            let p = pattern(lattice, 0.3);
+            for (i, j) in [(0, 0), (3, 1), (-2, -3), (7, 4)] {
+                let c = p.cell_centre(i, j);
+                assert!(
+                    p.nearest_centre(c).distance(c) < 1e-9,
+                    "{lattice:?} {i} {j}"
+                );
+                let off = c + DVec2::new(0.1, 0.05) * p.pitch;
+                assert!(p.nearest_centre(off).distance(c) < 1e-9);
+            }
+        }
+    }
+
+    #[test]
     fn out_of_range_density_is_found() {
         let mut p = pattern(Lattice::Square, 0.1);
         assert_eq!(p.first_out_of_range(), None);
-        p.density = vec![0.1, 1.0];
+        p.density = Density::Polynomial(vec![0.1, 1.0]);
         let (u, d) = p.first_out_of_range().unwrap();
         assert!(d > PI / 4.0 && u > 60.0 && u < 70.0, "u={u} d={d}");
-        p.density = vec![-0.01];
+        p.density = Density::Polynomial(vec![-0.01]);
         assert!(p.first_out_of_range().is_some());
     }
 }

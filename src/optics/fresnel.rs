@@ -25,10 +25,14 @@ pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
 }
 
 /// Cosine of the refraction angle by Snell's law, or `None` under total internal reflection.
+///
+/// `cos_t^2 = 1 - eta^2 (1 - cos_i^2)` is evaluated as `(1 - eta)(1 + eta) + eta^2 cos_i^2`:
+/// the same number, without the cancellation of `1 - sin_t^2` at grazing incidence (at
+/// eta = 1 it is exactly `cos_i^2`, so an index-matched interface never bends a ray).
 pub fn cos_transmitted(cos_i: f64, n1: f64, n2: f64) -> Option<f64> {
     let eta = n1 / n2;
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
-    (sin2_t < 1.0).then(|| (1.0 - sin2_t).sqrt())
+    let cos2_t = (1.0 - eta) * (1.0 + eta) + eta * eta * (cos_i * cos_i).min(1.0);
+    (cos2_t > 0.0).then(|| cos2_t.sqrt())
 }
 
 /// The critical angle (radians) going from `n1` into `n2 < n1`; `None` when `n2 >= n1`.

@@ -29,10 +29,14 @@
 //! ```
 //!
 //! Opaque models (phong, lambert, mirror, absorber, dot ink) reflect back to the side
-//! the photon came from; a dielectric sends it to the other side's medium.
+//! the photon came from; a dielectric sends it to the other side's medium. Procedural
+//! `grooves` (V-grooves, prism films) and rough `diffuser` faces are dielectric
+//! interfaces too: see [`super::grooves`] and [`super::diffuser`] for their files and
+//! models.
 
 use super::dots::DotPattern;
-use super::{fresnel, sampling};
+use super::grooves::GroovePattern;
+use super::{diffuser, fresnel, sampling};
 use crate::geometry::SurfaceHit;
 use crate::rng::PhotonRng;
 use glam::DVec3;
@@ -84,6 +88,21 @@ pub enum SurfaceModel {
         pattern: DotPattern,
         /// Albedo of the ink (the rest is absorbed).
         ink_albedo: f64,
+    },
+    /// Dielectric interface carrying procedural V-grooves or prisms (see
+    /// [`super::grooves`]).
+    Grooves {
+        /// The two media either side of the relief.
+        interface: Interface,
+        /// The groove layout.
+        pattern: GroovePattern,
+    },
+    /// Rough (diffusing) dielectric interface (see [`super::diffuser`]).
+    Diffuser {
+        /// The two media either side.
+        interface: Interface,
+        /// GGX roughness alpha (0: smooth).
+        roughness: f64,
     },
     /// Phong reflector.
     Phong(Phong),
@@ -195,6 +214,43 @@ impl SurfaceModel {
                     dielectric(media, interface, hit.normal, dir, rng)
                 }
             }
+            SurfaceModel::Grooves { interface, pattern } => {
+                let n = (
+                    media[interface.inside as usize].n,
+                    media[interface.outside as usize].n,
+                );
+                match pattern.scatter(n, hit.point, hit.normal, dir, rng) {
+                    Some((dir, inside)) => Outcome::Scattered {
+                        dir,
+                        medium: if inside {
+                            interface.inside
+                        } else {
+                            interface.outside
+                        },
+                        weight: 1.0,
+                    },
+                    None => dielectric(media, interface, hit.normal, dir, rng),
+                }
+            }
+            SurfaceModel::Diffuser {
+                interface,
+                roughness,
+            } => {
+                let n = (
+                    media[interface.inside as usize].n,
+                    media[interface.outside as usize].n,
+                );
+                let (dir, inside) = diffuser::scatter(*roughness, n, hit.normal, dir, rng);
+                Outcome::Scattered {
+                    dir,
+                    medium: if inside {
+                        interface.inside
+                    } else {
+                        interface.outside
+                    },
+                    weight: 1.0,
+                }
+            }
             SurfaceModel::Phong(p) => reflect(p.reflectance, rng, &|rng| {
                 phong_direction(p, facing, dir, rng)
             }),
@@ -211,6 +267,8 @@ impl SurfaceModel {
         match self {
             SurfaceModel::Dielectric(_) => "dielectric",
             SurfaceModel::Dots { .. } => "dots",
+            SurfaceModel::Grooves { .. } => "grooves",
+            SurfaceModel::Diffuser { .. } => "diffuser",
             SurfaceModel::Phong(_) => "phong",
             SurfaceModel::Lambert { .. } => "lambert",
             SurfaceModel::Mirror { .. } => "mirror",
@@ -221,7 +279,10 @@ impl SurfaceModel {
     /// The interface of a dielectric-like model.
     pub fn interface(&self) -> Option<Interface> {
         match self {
-            SurfaceModel::Dielectric(i) | SurfaceModel::Dots { interface: i, .. } => Some(*i),
+            SurfaceModel::Dielectric(i)
+            | SurfaceModel::Dots { interface: i, .. }
+            | SurfaceModel::Grooves { interface: i, .. }
+            | SurfaceModel::Diffuser { interface: i, .. } => Some(*i),
             _ => None,
         }
     }

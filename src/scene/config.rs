@@ -36,6 +36,7 @@
 //! the modules that implement them.
 
 use crate::optics::dots::{Lattice, XUnit};
+use crate::optics::grooves::Relief;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -132,17 +133,71 @@ pub enum SurfaceSpec {
         /// Propagation direction.
         axis: [f64; 3],
         /// In-face direction across `axis` (default: face normal x axis, found at load).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         across: Option<[f64; 3]>,
         /// Span along `axis` (mm).
         length_mm: f64,
-        /// Density polynomial coefficients, lowest degree first.
-        density: Vec<f64>,
+        /// Density polynomial coefficients, lowest degree first (or `density_table`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        density: Option<Vec<f64>>,
+        /// Tabulated density: knots `[x, d]`, x increasing, linear between (or `density`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        density_table: Option<Vec<[f64; 2]>>,
         /// Unit of the polynomial variable.
         #[serde(default)]
         x_unit: XUnit,
         /// Lamps on both edges: measure from the nearer.
         #[serde(default)]
         mirror: bool,
+    },
+    /// Dielectric interface carrying procedural V-grooves or prisms
+    /// ([`crate::optics::grooves`]).
+    Grooves {
+        /// Medium behind the face.
+        inside: String,
+        /// Medium in front of the face.
+        #[serde(default = "air")]
+        outside: String,
+        /// Notches cut into `inside`, or prisms raised out of the face.
+        relief: Relief,
+        /// Angle between the two facets (deg), in (0, 180).
+        apex_deg: f64,
+        /// Tilt of the V (deg): the facet on the `-axis` side gets base angle
+        /// `90 - apex/2 + tilt`, the other `90 - apex/2 - tilt`.
+        #[serde(default)]
+        tilt_deg: f64,
+        /// Groove pitch (mm).
+        pitch_mm: f64,
+        /// A point on the lamp edge (where the first cell starts).
+        origin: [f64; 3],
+        /// In-face direction across the grooves (away from the lamp).
+        axis: [f64; 3],
+        /// Span along `axis` (mm); needed when the fill varies or is mirrored.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        length_mm: Option<f64>,
+        /// Fill fraction polynomial, lowest degree first (default `[1.0]`; or
+        /// `density_table`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        density: Option<Vec<f64>>,
+        /// Tabulated fill fraction: knots `[x, f]`, x increasing (or `density`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        density_table: Option<Vec<[f64; 2]>>,
+        /// Unit of the polynomial variable.
+        #[serde(default)]
+        x_unit: XUnit,
+        /// Lamps on both edges: measure from the nearer.
+        #[serde(default)]
+        mirror: bool,
+    },
+    /// Rough (diffusing) dielectric interface ([`crate::optics::diffuser`]).
+    Diffuser {
+        /// Medium behind the face.
+        inside: String,
+        /// Medium in front of the face.
+        #[serde(default = "air")]
+        outside: String,
+        /// GGX roughness alpha (0: smooth).
+        roughness: f64,
     },
     /// Phong reflector.
     Phong {
@@ -210,9 +265,14 @@ pub enum SourceSpec {
         power_w: f64,
         /// Luminous flux (lm), for luminance outputs.
         lumens: Option<f64>,
-        /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere).
-        #[serde(default = "one")]
-        cos_exponent: f64,
+        /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere); default 1.
+        /// Not with `intensity_file`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cos_exponent: Option<f64>,
+        /// Measured intensity table, `.csv` or `.ies` (relative to the scene file); see
+        /// [`crate::sources::intensity`].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        intensity_file: Option<PathBuf>,
         /// Medium in front of the emitter.
         #[serde(default = "air")]
         medium: String,

@@ -10,14 +10,16 @@
 
 pub mod config;
 pub mod meshio;
+mod relief;
 mod solids;
 
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};
-use crate::optics::dots::DotPattern;
+use crate::optics::dots::{Density, DotPattern};
 use crate::optics::surface::{Interface, Medium, MediumId, Phong, SurfaceModel};
 use crate::rng::PhotonRng;
+use crate::sources::intensity::IntensityProfile;
 use crate::sources::{Emitter, Source, Sources};
 use anyhow::{Context, Result};
 use config::{DetectorSpec, SceneFile, SourceSpec, SurfaceSpec};
@@ -159,6 +161,7 @@ impl Scene {
         }
         solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
         finish_dot_patterns(&ctx, &mesh, &tags, &mut surfaces)?;
+        relief::finish_groove_patterns(&ctx, &mesh, &tags, &mut surfaces)?;
         let sources = build_sources(&ctx, &file.sources, &media)?;
         let detector = build_detector(&ctx, &file.detector)?;
         if file.trace.max_bounces == 0 {
@@ -206,6 +209,9 @@ impl Scene {
         self.detector.origin -= c;
         for s in &mut self.surfaces {
             if let SurfaceModel::Dots { pattern, .. } = s {
+                pattern.origin -= c;
+            }
+            if let SurfaceModel::Grooves { pattern, .. } = s {
                 pattern.origin -= c;
             }
         }
@@ -353,6 +359,9 @@ impl Fnv1a {
     }
 }
 
+/// Largest vertex coordinate (mm) a geometry file may have after scale and translate.
+pub const MAX_COORDINATE: f64 = 1e12;
+
 /// The spawn offset for a scene whose coordinates reach `extent` mm: a few f32 ulps
 /// there, so single-precision backends never re-hit the surface a ray leaves.
 pub fn spawn_epsilon(extent: f64) -> f64 {
@@ -436,6 +445,26 @@ fn load_geometry(
             ));
         }
         let tris = meshio::load(&gpath, transform)?;
+        // NaN or infinite vertices would poison the bounds, the recentring and the f32
+        // backends (a panic in the BVH build); beyond 1e12 mm f64 resolves no better than
+        // 0.1 mm: a unit or export error either way.
+        if let Some((k, p)) = tris
+            .positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(ctx.err(
+                &format!("geometry[{i}].file"),
+                format!(
+                    "{}: vertex {k} is at ({:?}, {:?}, {:?}) mm after scale and translate; coordinates must be finite and within {MAX_COORDINATE:e} mm",
+                    gpath.display(),
+                    p.x,
+                    p.y,
+                    p.z
+                ),
+            ));
+        }
         let base = mesh.positions.len() as u32;
         mesh.positions.extend(&tris.positions);
         let mut dropped = 0;
@@ -510,14 +539,28 @@ fn build_surface(
             across,
             length_mm,
             density,
+            density_table,
             x_unit,
             mirror,
         } => {
-            if density.is_empty() {
-                return Err(ctx.err(&f("density"), "needs at least one coefficient"));
-            }
-            for (i, c) in density.iter().enumerate() {
-                ctx.finite(&format!("{}[{i}]", f("density")), *c)?;
+            let (density, field) = match (density, density_table) {
+                (Some(c), None) => (Density::Polynomial(c.clone()), f("density")),
+                (None, Some(k)) => (Density::Table(k.clone()), f("density_table")),
+                (Some(_), Some(_)) => {
+                    return Err(ctx.err(
+                        &f("density"),
+                        "give either density (polynomial) or density_table, not both",
+                    ));
+                }
+                (None, None) => {
+                    return Err(ctx.err(
+                        &f("density"),
+                        "missing: give density (polynomial coefficients) or density_table ([x, d] knots)",
+                    ));
+                }
+            };
+            if let Some(problem) = density.problem() {
+                return Err(ctx.err(&field, problem));
             }
             let pattern = DotPattern {
                 lattice: *lattice,
@@ -529,12 +572,12 @@ fn build_surface(
                     None => DVec3::ZERO,
                 },
                 length: ctx.positive(&f("length_mm"), *length_mm)?,
-                density: density.clone(),
+                density,
                 x_unit: *x_unit,
                 mirror: *mirror,
             };
             if let Some((u, d)) = pattern.first_out_of_range() {
-                return Err(ctx.err(&f("density"), format!(
+                return Err(ctx.err(&field, format!(
                     "d(x) = {d:.4} at {u:.3} mm from the origin is outside [0, {:.4}] (the {:?} lattice's packing limit)",
                     lattice.max_packing(), lattice
                 )));
@@ -561,6 +604,9 @@ fn build_surface(
             reflectance: ctx.fraction(&f("reflectance"), *reflectance)?,
         },
         SurfaceSpec::Absorber {} => SurfaceModel::Absorber,
+        SurfaceSpec::Grooves { .. } | SurfaceSpec::Diffuser { .. } => {
+            relief::build(ctx, tag, spec, media)?.expect("grooves and diffuser are relief models")
+        }
     })
 }
 
@@ -642,6 +688,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 power_w,
                 lumens,
                 cos_exponent,
+                intensity_file,
                 medium,
             } => {
                 let n = ctx.direction(&f("normal"), *normal)?;
@@ -649,17 +696,43 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 if u.dot(n).abs() > 1e-6 {
                     return Err(ctx.err(&f("u"), "must be perpendicular to normal"));
                 }
+                let (center, width, height) = (
+                    ctx.point(&f("center"), *center)?,
+                    ctx.positive(&f("width_mm"), *width_mm)?,
+                    ctx.positive(&f("height_mm"), *height_mm)?,
+                );
                 Source {
                     name: name.clone().unwrap_or_else(|| format!("led{i}")),
                     power_w: ctx.positive(&f("power_w"), *power_w)?,
                     lumens: optional_positive(ctx, &f("lumens"), *lumens)?,
-                    emitter: Emitter::Led {
-                        center: ctx.point(&f("center"), *center)?,
-                        normal: n,
-                        u,
-                        width: ctx.positive(&f("width_mm"), *width_mm)?,
-                        height: ctx.positive(&f("height_mm"), *height_mm)?,
-                        cos_exponent: ctx.non_negative(&f("cos_exponent"), *cos_exponent)?,
+                    emitter: match (intensity_file, cos_exponent) {
+                        (Some(_), Some(_)) => {
+                            return Err(ctx.err(
+                                &f("intensity_file"),
+                                "give either cos_exponent or intensity_file, not both",
+                            ));
+                        }
+                        (Some(file), None) => {
+                            let dir = ctx.0.parent().unwrap_or(Path::new("."));
+                            let profile = IntensityProfile::read(&dir.join(file))
+                                .map_err(|e| ctx.err(&f("intensity_file"), e))?;
+                            Emitter::MeasuredLed {
+                                center,
+                                normal: n,
+                                u,
+                                width,
+                                height,
+                                profile: Arc::new(profile),
+                            }
+                        }
+                        (None, m) => Emitter::Led {
+                            center,
+                            normal: n,
+                            u,
+                            width,
+                            height,
+                            cos_exponent: ctx.non_negative(&f("cos_exponent"), m.unwrap_or(1.0))?,
+                        },
                     },
                     medium: medium_id(ctx, &f("medium"), medium, media)?,
                 }

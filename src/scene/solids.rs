@@ -44,18 +44,47 @@ pub(super) fn orient_closed_solids(
     Ok(())
 }
 
-/// Weld key: positions equal to a relative 1e-9 of the scene size are one vertex.
+/// Weld: each position within `q` = 1e-9 of the scene diagonal (in every coordinate) of an
+/// earlier one is that vertex. Returns, per position, the index of its representative.
+/// Points are binned in cells of 4q and also looked up in the neighbouring cells they lie
+/// within q of, so two copies of a vertex that straddle a cell boundary still weld.
 fn weld(mesh: &Mesh) -> Vec<u32> {
     let q = (mesh.bounds().diagonal() * 1e-9).max(1e-12);
-    let mut ids: HashMap<[i64; 3], u32> = HashMap::new();
-    mesh.positions
-        .iter()
-        .map(|p| {
-            let key = (*p / q).round().to_array().map(|c| c as i64);
-            let next = ids.len() as u32;
-            *ids.entry(key).or_insert(next)
-        })
-        .collect()
+    let cell = 4.0 * q;
+    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut rep = Vec::with_capacity(mesh.positions.len());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let f = *p / cell;
+        let key = f.floor().to_array().map(|c| c as i64);
+        let side = |r: f64| match r {
+            r if r < 0.25 => -1,
+            r if r > 0.75 => 1,
+            _ => 0,
+        };
+        let steps = (f - f.floor()).to_array().map(|r| [0, side(r)]);
+        let mut found = None;
+        'search: for dx in steps[0] {
+            for dy in steps[1] {
+                for dz in steps[2] {
+                    let k = [key[0] + dx, key[1] + dy, key[2] + dz];
+                    let near = cells.get(&k).and_then(|c| {
+                        c.iter()
+                            .copied()
+                            .find(|&j| (mesh.positions[j as usize] - *p).abs().max_element() <= q)
+                    });
+                    if near.is_some() {
+                        found = near;
+                        break 'search;
+                    }
+                }
+            }
+        }
+        rep.push(found.unwrap_or_else(|| {
+            cells.entry(key).or_default().push(i as u32);
+            i as u32
+        }));
+    }
+    rep
 }
 
 fn orient(
@@ -76,23 +105,34 @@ fn orient(
             edges.entry((a.min(b), a.max(b))).or_default().push(p);
         }
     }
-    let bad: Vec<(&(u32, u32), usize)> = edges
-        .iter()
-        .filter(|(_, t)| t.len() != 2)
-        .map(|(e, t)| (e, t.len()))
-        .collect();
-    if let Some(&(&(a, _), n)) = bad.first() {
+    // Bad edges by kind, sorted, so the message counts each kind and its example is the
+    // same on every run (a HashMap's order is not).
+    let kind = |pred: fn(usize) -> bool| {
+        let mut e: Vec<(u32, u32)> = edges
+            .iter()
+            .filter(|(_, t)| pred(t.len()))
+            .map(|(e, _)| *e)
+            .collect();
+        e.sort_unstable();
+        e
+    };
+    let (open, crowded) = (kind(|n| n == 1), kind(|n| n > 2));
+    if let Some(&(a, _)) = open.first().or(crowded.first()) {
         let at = mesh.positions[welded.iter().position(|&w| w == a).unwrap_or(0)];
-        let what = if n == 1 {
-            "open (a gap or T-junction)"
-        } else {
-            "shared by more than two faces"
-        };
+        let what = [
+            (open.len(), "open (a gap or T-junction)"),
+            (crowded.len(), "shared by more than two faces"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, w)| format!("{n} edge(s) {w}"))
+        .collect::<Vec<_>>()
+        .join(" and ");
         return Err(ctx.err(
             &format!("surfaces ({})", names.join(", ")),
             format!(
-                "medium '{medium}' is not enclosed by a closed surface: {} edge(s) {what}, e.g. at ({:.4}, {:.4}, {:.4}) mm",
-                bad.len(), at.x, at.y, at.z
+                "medium '{medium}' is not enclosed by a closed surface: {what}, e.g. at ({:.4}, {:.4}, {:.4}) mm",
+                at.x, at.y, at.z
             ),
         ));
     }
@@ -133,6 +173,9 @@ fn orient(
             .sum();
         let invert = volume < 0.0;
         for p in comp {
+            // Welded copies become one vertex, so the traced surface is as closed as the
+            // check above found it (no cracks between near-duplicate corners).
+            mesh.triangles[p] = mesh.triangles[p].map(|v| welded[v as usize]);
             if flip[&p] != invert {
                 let t = &mut mesh.triangles[p];
                 t.swap(1, 2);

@@ -46,6 +46,12 @@ pub fn all_files() -> Vec<GenFile> {
     files.extend(scenes::test_slab::files());
     files.extend(scenes::test_slab_edge_lit::files());
     files.extend(scenes::test_two_tags::files());
+    files.extend(scenes::phone_led::files());
+    files.extend(scenes::direct_lit::files());
+    files.extend(scenes::cad_reflector::files());
+    files.extend(scenes::prism_plate::files());
+    files.extend(scenes::prism_plate::files_meshed());
+    files.extend(scenes::bef_stack::files());
     files
 }
 

@@ -1,7 +1,12 @@
 //! One module per bundled scene. Each exposes its dimensions as constants, its geometry as
 //! [`crate::Part`]s and `files()`, the generated files.
 
+pub mod bef_stack;
+pub mod cad_reflector;
+pub mod direct_lit;
 pub mod notebook14;
+pub mod phone_led;
+pub mod prism_plate;
 pub mod test_slab;
 pub mod test_slab_edge_lit;
 pub mod test_two_tags;

@@ -1,0 +1,180 @@
+//! The manufacturable dot pattern: every dot on the face with its diameter, as CSV, SVG
+//! and DXF.
+//!
+//! ```text
+//! blutrace optimize SCENE --out DIR   # writes DIR/dots.csv, DIR/dots.svg, DIR/dots.dxf
+//! ```
+//!
+//! Coordinates are the face coordinates of the dot pattern, in mm: `x` along the
+//! pattern's `axis` and `y` along its `across` direction, both from its `origin`:
+//!
+//! ```toml
+//! [surfaces.lgp_back]
+//! model = "dots"
+//! origin = [0.0, 0.0, 0.0]   # dots.csv (x, y) = (0, 0) here
+//! axis = [1.0, 0.0, 0.0]     # dots.csv x
+//! ```
+//!
+//! A dot is listed when its centre lies on the face (inside one of the tag's triangles);
+//! its diameter is `2 sqrt(d(x) A / pi)` with `A` the cell area, so the dots cover the
+//! fraction `d(x)` of the face around `x`. The DXF is plain R12 ASCII: one `CIRCLE`
+//! entity per dot on layer `DOTS`, in mm, readable by CAD and printer software.
+
+use crate::optics::dots::DotPattern;
+use anyhow::{Context, Result, bail};
+use glam::{DVec2, DVec3};
+use std::collections::HashSet;
+use std::fmt::Write;
+
+/// One printed dot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dot {
+    /// Position along the pattern axis (mm from the origin).
+    pub x: f64,
+    /// Position across the axis (mm from the origin).
+    pub y: f64,
+    /// Diameter (mm).
+    pub diameter: f64,
+}
+
+/// Every dot whose centre lies on the face made of `triangles` (scene coordinates, the
+/// same frame as `pattern.origin`), in row order. Dots of zero diameter are left out.
+pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Vec<Dot> {
+    let h = pattern.row_spacing();
+    let p = pattern.pitch;
+    let mut seen = HashSet::new();
+    let mut cells = Vec::new();
+    for tri in triangles {
+        let q = tri.map(|v| pattern.face_coords(v));
+        let (lo, hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        let (j0, j1) = ((lo.y / h).floor() as i64 - 1, (hi.y / h).ceil() as i64 + 1);
+        let (i0, i1) = ((lo.x / p).floor() as i64 - 1, (hi.x / p).ceil() as i64 + 1);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let c = pattern.cell_centre(i, j);
+                if inside_triangle(c, q) && seen.insert((j, i)) {
+                    cells.push((j, i, c));
+                }
+            }
+        }
+    }
+    cells.sort_by_key(|&(j, i, _)| (j, i));
+    cells
+        .into_iter()
+        .map(|(_, _, c)| Dot {
+            x: c.x,
+            y: c.y,
+            diameter: 2.0 * pattern.dot_radius_at(c.x),
+        })
+        .filter(|d| d.diameter > 0.0)
+        .collect()
+}
+
+/// Point in triangle (2-D), boundary included; works for either winding.
+fn inside_triangle(p: DVec2, t: [DVec2; 3]) -> bool {
+    let cross = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+    let s = [
+        cross(t[0], t[1], p),
+        cross(t[1], t[2], p),
+        cross(t[2], t[0], p),
+    ];
+    let eps = 1e-12 * (t[1] - t[0]).length_squared().max(1.0);
+    s.iter().all(|&v| v >= -eps) || s.iter().all(|&v| v <= eps)
+}
+
+/// `x_mm,y_mm,diameter_mm` with a header line, positions to 0.1 um.
+pub fn to_csv(dots: &[Dot]) -> String {
+    let mut s = String::with_capacity(32 * dots.len() + 32);
+    s.push_str("x_mm,y_mm,diameter_mm\n");
+    for d in dots {
+        let _ = writeln!(s, "{:.4},{:.4},{:.5}", d.x, d.y, d.diameter);
+    }
+    s
+}
+
+/// Read back what [`to_csv`] wrote.
+pub fn parse_csv(text: &str) -> Result<Vec<Dot>> {
+    let mut lines = text.lines();
+    match lines.next() {
+        Some(h) if h.trim() == "x_mm,y_mm,diameter_mm" => {}
+        _ => bail!("dots CSV: expected the header x_mm,y_mm,diameter_mm"),
+    }
+    lines
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            let v: Vec<f64> = l
+                .split(',')
+                .map(|f| f.trim().parse::<f64>())
+                .collect::<std::result::Result<_, _>>()
+                .with_context(|| format!("dots CSV line {}: not three numbers", i + 2))?;
+            match v[..] {
+                [x, y, diameter] => Ok(Dot { x, y, diameter }),
+                _ => bail!(
+                    "dots CSV line {}: expected 3 fields, got {}",
+                    i + 2,
+                    v.len()
+                ),
+            }
+        })
+        .collect()
+}
+
+/// An SVG drawing of the dots in mm (1 user unit = 1 mm), face `y` pointing up.
+pub fn to_svg(dots: &[Dot]) -> String {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for d in dots {
+        let r = 0.5 * d.diameter;
+        lo = lo.min(DVec2::new(d.x - r, d.y - r));
+        hi = hi.max(DVec2::new(d.x + r, d.y + r));
+    }
+    if dots.is_empty() {
+        (lo, hi) = (DVec2::ZERO, DVec2::ONE);
+    }
+    let size = hi - lo;
+    let mut s = String::with_capacity(48 * dots.len() + 512);
+    let _ = writeln!(
+        s,
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" \
+         width=\"{w:.4}mm\" height=\"{h:.4}mm\" viewBox=\"{x:.4} {y:.4} {w:.4} {h:.4}\">",
+        w = size.x,
+        h = size.y,
+        x = lo.x,
+        y = -hi.y,
+    );
+    let _ = writeln!(
+        s,
+        "<!-- blutrace dot pattern: {} dots; x along the pattern axis, y across it (mm) -->",
+        dots.len()
+    );
+    s.push_str("<g transform=\"scale(1,-1)\" fill=\"black\" stroke=\"none\">\n");
+    for d in dots {
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{:.4}\" cy=\"{:.4}\" r=\"{:.5}\"/>",
+            d.x,
+            d.y,
+            0.5 * d.diameter
+        );
+    }
+    s.push_str("</g>\n</svg>\n");
+    s
+}
+
+/// A minimal ASCII DXF (R12): one `CIRCLE` per dot on layer `DOTS`, units mm.
+pub fn to_dxf(dots: &[Dot]) -> String {
+    let mut s = String::with_capacity(64 * dots.len() + 256);
+    s.push_str("0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n");
+    s.push_str("0\nSECTION\n2\nENTITIES\n");
+    for d in dots {
+        let _ = write!(
+            s,
+            "0\nCIRCLE\n8\nDOTS\n10\n{:.4}\n20\n{:.4}\n30\n0.0\n40\n{:.5}\n",
+            d.x,
+            d.y,
+            0.5 * d.diameter
+        );
+    }
+    s.push_str("0\nENDSEC\n0\nEOF\n");
+    s
+}

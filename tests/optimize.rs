@@ -1,0 +1,512 @@
+//! Dot-density optimization: Nelder-Mead on known functions, density-to-radius, dot export
+//! round trips, the tabulated density in scene files, and optimizers that provably improve
+//! a small fast scene. The notebook14 acceptance runs are `#[ignore]`d (minutes each).
+
+mod support;
+
+use blutrace::optics::dots::{Density, DotPattern, Lattice, XUnit};
+use blutrace::optimize::export::{self, Dot};
+use blutrace::optimize::nelder_mead::{self, Settings, Termination};
+use blutrace::optimize::{Method, OptimizeOptions, optimize};
+use blutrace::scene::Scene;
+use glam::DVec3;
+use std::f64::consts::PI;
+use support::{box_obj, load, write_scene};
+
+fn rosenbrock(x: &[f64]) -> f64 {
+    (1.0 - x[0]).powi(2) + 100.0 * (x[1] - x[0] * x[0]).powi(2)
+}
+
+#[test]
+fn nelder_mead_minimizes_rosenbrock() {
+    let settings = Settings {
+        max_iter: 2000,
+        x_tol: 1e-9,
+        ..Settings::default()
+    };
+    let mut steps_seen = 0;
+    let out = nelder_mead::minimize(
+        &mut |x| Ok(rosenbrock(x)),
+        &[-1.2, 1.0],
+        &[0.1, 0.1],
+        &settings,
+        &mut |_| steps_seen += 1,
+    )
+    .unwrap();
+    assert_eq!(out.termination, Termination::SimplexSize);
+    assert!(
+        (out.x[0] - 1.0).abs() < 1e-6 && (out.x[1] - 1.0).abs() < 1e-6,
+        "{:?}",
+        out.x
+    );
+    assert!(out.value < 1e-12, "f = {}", out.value);
+    assert_eq!(
+        steps_seen,
+        out.iterations + 1,
+        "one report per iteration, plus the start"
+    );
+    assert!(out.iterations < 400, "{} iterations", out.iterations);
+}
+
+#[test]
+fn nelder_mead_minimizes_a_quadratic_and_honours_the_tests() {
+    // f = sum w_i (x_i - i)^2 in 4-D, a scaled bowl like the density coefficients.
+    let f = |x: &[f64]| -> f64 {
+        x.iter()
+            .enumerate()
+            .map(|(i, v)| (1.0 + i as f64) * (v - i as f64).powi(2))
+            .sum()
+    };
+    let x0 = [3.0, -2.0, 0.5, 1.0];
+    let steps = [0.5; 4];
+    let out = nelder_mead::minimize(
+        &mut |x| Ok(f(x)),
+        &x0,
+        &steps,
+        &Settings {
+            max_iter: 5000,
+            x_tol: 1e-8,
+            ..Settings::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    for (i, v) in out.x.iter().enumerate() {
+        assert!((v - i as f64).abs() < 1e-5, "x = {:?}", out.x);
+    }
+    // The objective bound stops early.
+    let bound = nelder_mead::minimize(
+        &mut |x| Ok(f(x)),
+        &x0,
+        &steps,
+        &Settings {
+            target: Some(0.5),
+            ..Settings::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(bound.termination, Termination::ObjectiveBound);
+    assert!(bound.value <= 0.5 && bound.iterations < out.iterations);
+    // The iteration cap stops too.
+    let capped = nelder_mead::minimize(
+        &mut |x| Ok(f(x)),
+        &x0,
+        &steps,
+        &Settings {
+            max_iter: 5,
+            ..Settings::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(capped.termination, Termination::MaxIterations);
+    assert_eq!(capped.iterations, 5);
+    // Rejected points (infinite, NaN) never win, and errors come back as errors.
+    let walled = nelder_mead::minimize(
+        &mut |x| Ok(if x[0] < 1.5 { f64::NAN } else { f(x) }),
+        &x0,
+        &steps,
+        &Settings {
+            max_iter: 500,
+            ..Settings::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(walled.x[0] >= 1.5 && walled.value.is_finite());
+    let failed = nelder_mead::minimize(
+        &mut |_| anyhow::bail!("trace failed"),
+        &x0,
+        &steps,
+        &Settings::default(),
+        &mut |_| {},
+    );
+    assert!(failed.is_err());
+}
+
+#[test]
+fn density_to_radius_for_square_and_hex_cells() {
+    for (lattice, cell) in [(Lattice::Square, 1.0), (Lattice::Hex, 3f64.sqrt() / 2.0)] {
+        let pitch = 0.8;
+        assert!((lattice.cell_area(pitch) - cell * pitch * pitch).abs() < 1e-12);
+        for d in [0.01, 0.2, 0.5] {
+            let r = lattice.dot_radius(pitch, d);
+            let frac = PI * r * r / lattice.cell_area(pitch);
+            assert!((frac - d).abs() < 1e-12, "{lattice:?} d = {d}: {frac}");
+        }
+        // At the packing limit neighbouring dots just touch: diameter = pitch.
+        let r = lattice.dot_radius(pitch, lattice.max_packing());
+        assert!((2.0 * r - pitch).abs() < 1e-12, "{lattice:?}: {r}");
+        assert_eq!(lattice.dot_radius(pitch, -0.1), 0.0);
+    }
+}
+
+fn pattern(lattice: Lattice, density: Density) -> DotPattern {
+    DotPattern {
+        lattice,
+        pitch: 0.5,
+        origin: DVec3::ZERO,
+        axis: DVec3::X,
+        across: DVec3::Y,
+        length: 30.0,
+        density,
+        x_unit: XUnit::Normalized,
+        mirror: false,
+    }
+}
+
+/// Two triangles covering x 0..30, y 0..12 at z = 0.
+fn rectangle() -> Vec<[DVec3; 3]> {
+    let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+    vec![
+        [p(0.0, 0.0), p(30.0, 0.0), p(30.0, 12.0)],
+        [p(0.0, 0.0), p(30.0, 12.0), p(0.0, 12.0)],
+    ]
+}
+
+/// Ink area of the dots with centres in each strip (width `strip`, the first starting at
+/// `offset`) over the strip's area.
+fn area_fraction_per_strip(
+    dots: &[Dot],
+    offset: f64,
+    strip: f64,
+    n: usize,
+    height: f64,
+) -> Vec<f64> {
+    let mut ink = vec![0.0; n];
+    for d in dots {
+        let k = ((d.x - offset) / strip).floor();
+        if k >= 0.0 && (k as usize) < n {
+            ink[k as usize] += PI * d.diameter * d.diameter / 4.0;
+        }
+    }
+    ink.iter().map(|a| a / (strip * height)).collect()
+}
+
+#[test]
+fn exported_dots_round_trip_to_the_density() {
+    let density = Density::Polynomial(vec![0.05, 0.2, 0.4]);
+    // Square strips are one column of cells; hex strips are 6 pitches wide and start a
+    // quarter pitch in, so every row (shifted or not) has exactly 6 dots in each.
+    for (lattice, offset, strip) in [(Lattice::Square, 0.0, 0.5), (Lattice::Hex, 0.125, 3.0)] {
+        let p = pattern(lattice, density.clone());
+        let dots = export::dots_on_face(&p, &rectangle());
+        assert!(
+            dots.iter()
+                .all(|d| (0.0..=30.0).contains(&d.x) && (0.0..=12.0).contains(&d.y))
+        );
+        let csv = export::to_csv(&dots);
+        let back = export::parse_csv(&csv).unwrap();
+        assert_eq!(back.len(), dots.len());
+        // Rows with centres on the face (y = (j + 1/2) h <= 12): 24 square, 28 hex.
+        let rows = (12.0 / p.row_spacing() - 0.5).floor() + 1.0;
+        let height = rows * p.row_spacing();
+        let n = ((30.0 - offset) / strip) as usize;
+        let got = area_fraction_per_strip(&back, offset, strip, n, height);
+        for (k, g) in got.iter().enumerate() {
+            let u = offset + (k as f64 + 0.5) * strip;
+            let want = p.density_at(u);
+            assert!(
+                (g - want).abs() < 1e-3,
+                "{lattice:?} strip {k} at {u} mm: exported area fraction {g:.5}, d(x) = {want:.5}"
+            );
+        }
+    }
+    // A tabulated density exports the same way.
+    let p = pattern(
+        Lattice::Square,
+        Density::Table(vec![[0.0, 0.1], [1.0, 0.5]]),
+    );
+    let dots = export::dots_on_face(&p, &rectangle());
+    let got = area_fraction_per_strip(&dots, 0.0, 0.5, 60, 12.0);
+    for (k, g) in got.iter().enumerate() {
+        let want = p.density_at((k as f64 + 0.5) * 0.5);
+        assert!((g - want).abs() < 1e-4, "table strip {k}: {g} vs {want}");
+    }
+}
+
+#[test]
+fn svg_and_dxf_hold_every_dot() {
+    let p = pattern(Lattice::Hex, Density::Polynomial(vec![0.2]));
+    let dots = export::dots_on_face(&p, &rectangle());
+    let svg = export::to_svg(&dots);
+    assert_eq!(svg.matches("<circle ").count(), dots.len());
+    assert!(svg.starts_with("<?xml") && svg.trim_end().ends_with("</svg>"));
+    let dxf = export::to_dxf(&dots);
+    assert_eq!(dxf.matches("\nCIRCLE\n").count(), dots.len());
+    assert!(dxf.ends_with("0\nEOF\n"));
+    // Radii in the DXF: group code 40 follows every circle.
+    let radii: Vec<f64> = dxf
+        .lines()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .filter(|w| w[0] == "40")
+        .map(|w| w[1].parse().unwrap())
+        .collect();
+    assert_eq!(radii.len(), dots.len());
+    let r = Lattice::Hex.dot_radius(0.5, 0.2);
+    assert!(radii.iter().all(|v| (v - r).abs() < 1e-5));
+}
+
+const LED: &str = "[[sources]]\ntype = \"led\"\ncenter = [-20.001, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\n\
+                   u = [0.0, 1.0, 0.0]\nwidth_mm = 10.0\nheight_mm = 0.9\npower_w = 1.0\n";
+
+/// A 40 x 10 x 1 mm PMMA plate lit from its -x end, dots on the back face.
+fn small_scene(name: &str, density: &str) -> std::path::PathBuf {
+    let obj = box_obj(
+        [-20.0, -5.0, -0.5],
+        [20.0, 5.0, 0.5],
+        ["edge", "edge", "edge", "edge", "dots", "face"],
+    );
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"plate.obj\"\n[media.pmma]\nn = 1.49\nabsorption_per_mm = 0.001\n\
+         [surfaces.face]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"square\"\npitch_mm = 0.5\n\
+         origin = [-20.0, 0.0, -0.5]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 40.0\n{density}\n{LED}\
+         [detector]\norigin = [-20.0, -5.0, 0.6]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [40.0, 10.0]\n\
+         bins = [20, 5]\n"
+    );
+    write_scene(name, &toml, &[("plate.obj", &obj)])
+}
+
+#[test]
+fn density_table_in_scene_files() {
+    let table = load(&small_scene(
+        "opt-table",
+        "density_table = [[0.0, 0.1], [0.5, 0.3], [1.0, 0.2]]",
+    ));
+    let dots = table
+        .surfaces
+        .iter()
+        .find_map(|s| match s {
+            blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
+            _ => None,
+        })
+        .unwrap();
+    assert!((dots.density_at(10.0) - 0.2).abs() < 1e-12);
+    let both = small_scene(
+        "opt-both",
+        "density = [0.1]\ndensity_table = [[0.0, 0.1], [1.0, 0.2]]",
+    );
+    let msg = format!("{:#}", Scene::load(&both).unwrap_err());
+    assert!(
+        msg.contains("surfaces.dots.density") && msg.contains("not both"),
+        "{msg}"
+    );
+    let neither = small_scene("opt-neither", "");
+    let msg = format!("{:#}", Scene::load(&neither).unwrap_err());
+    assert!(
+        msg.contains("density_table") && msg.contains("missing"),
+        "{msg}"
+    );
+    let unordered = small_scene("opt-unordered", "density_table = [[0.5, 0.1], [0.2, 0.2]]");
+    let msg = format!("{:#}", Scene::load(&unordered).unwrap_err());
+    assert!(
+        msg.contains("surfaces.dots.density_table") && msg.contains("increase"),
+        "{msg}"
+    );
+    let packing = small_scene("opt-packing", "density_table = [[0.0, 0.1], [1.0, 0.9]]");
+    let msg = format!("{:#}", Scene::load(&packing).unwrap_err());
+    assert!(
+        msg.contains("density_table") && msg.contains("packing"),
+        "{msg}"
+    );
+}
+
+fn small_options(method: Method) -> OptimizeOptions {
+    OptimizeOptions {
+        method,
+        photons: 40_000,
+        seed: 5,
+        max_iter: if method == Method::Feedback { 4 } else { 25 },
+        verify_photons: 80_000,
+        threads: Some(2),
+        ..OptimizeOptions::default()
+    }
+}
+
+#[test]
+fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
+    let scene = load(&small_scene("opt-small", "density = [0.3]"));
+    for method in [Method::NelderMead, Method::Feedback] {
+        let opts = small_options(method);
+        let mut lines = Vec::new();
+        let r = optimize(&scene, &opts, &mut |it| lines.push(it.to_string())).unwrap();
+        assert_eq!(lines.len(), r.history.len());
+        assert!(r.photons >= opts.photons * r.history.len() as u64 / 2);
+        // Better on the search's own (common random number) traces, by many sigma...
+        let (a, b) = (&r.initial, &r.best);
+        println!(
+            "{method}: {} iterations, {} designs, {} photons: {:.4} ± {:.4} -> {:.4} ± {:.4}",
+            r.iterations, r.evaluations, r.photons, a.objective, a.noise, b.objective, b.noise
+        );
+        assert!(
+            b.objective < a.objective - 5.0 * (a.noise + b.noise),
+            "{method}: {:.4} ± {:.4} -> {:.4} ± {:.4}",
+            a.objective,
+            a.noise,
+            b.objective,
+            b.noise
+        );
+        // ...and on the fresh-seed re-trace.
+        let v = r.verification.as_ref().unwrap();
+        let (a, b) = (&v.initial.evaluation, &v.final_design.evaluation);
+        assert!(
+            b.objective < 0.7 * a.objective,
+            "{method} re-trace: {:.4} -> {:.4}",
+            a.objective,
+            b.objective
+        );
+        // The density stays printable.
+        let min = opts.min_density - 1e-12;
+        let max = Lattice::Square.max_packing() + 1e-12;
+        assert!(r.dots.iter().all(|d| {
+            let frac = PI * d.diameter * d.diameter / 4.0 / 0.25;
+            frac >= min * 0.999 && frac <= max
+        }));
+        // The written scene traces as it is, with the new density.
+        let out =
+            std::env::temp_dir().join(format!("blutrace-opt-out-{}-{method}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let files = r.write(&out).unwrap();
+        for f in [
+            "optimized.toml",
+            "history.csv",
+            "density.png",
+            "profile.png",
+            "dots.csv",
+            "dots.svg",
+            "dots.dxf",
+            "optimize.json",
+            "initial/flux.exr",
+            "initial/summary.json",
+            "final/flux.exr",
+            "final/summary.json",
+        ] {
+            assert!(out.join(f).is_file(), "{method}: missing {f} in {files:?}");
+        }
+        let leftovers: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+            .collect();
+        assert!(leftovers.is_empty(), "staging files left: {leftovers:?}");
+        let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+        assert_eq!(history.lines().count(), r.history.len() + 1);
+        let again = Scene::load(&out.join("optimized.toml")).unwrap();
+        let d = again
+            .surfaces
+            .iter()
+            .find_map(|s| match s {
+                blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(d.density, r.final_density);
+        let csv = std::fs::read_to_string(out.join("dots.csv")).unwrap();
+        assert_eq!(export::parse_csv(&csv).unwrap().len(), r.dots.len());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
+
+#[test]
+fn infeasible_designs_are_penalized_not_traced() {
+    let scene = load(&small_scene("opt-infeasible", "density = [0.3]"));
+    let opts = OptimizeOptions {
+        photons: 5_000,
+        max_iter: 6,
+        // A huge first step leaves the printable range: penalties, never a panic.
+        initial_step: 5.0,
+        verify_photons: 0,
+        threads: Some(1),
+        ..OptimizeOptions::default()
+    };
+    let r = optimize(&scene, &opts, &mut |_| {}).unwrap();
+    assert!(
+        r.evaluations > r.photons as usize / opts.photons as usize,
+        "some designs were rejected untraced"
+    );
+    assert!(r.best.objective.is_finite());
+    assert!(r.verification.is_none());
+    // Bad options are errors.
+    for bad in [
+        OptimizeOptions {
+            min_density: 0.95,
+            ..opts.clone()
+        },
+        OptimizeOptions {
+            photons: 0,
+            ..opts.clone()
+        },
+        OptimizeOptions {
+            tag: Some("face".into()),
+            ..opts.clone()
+        },
+        OptimizeOptions {
+            tag: Some("nope".into()),
+            ..opts.clone()
+        },
+        OptimizeOptions {
+            method: Method::Feedback,
+            alpha: -1.0,
+            ..opts.clone()
+        },
+    ] {
+        assert!(optimize(&scene, &bad, &mut |_| {}).is_err());
+    }
+}
+
+/// Acceptance on notebook14 (minutes): Nelder-Mead from the constant density.
+#[test]
+#[ignore = "minutes: cargo test --release --test optimize -- --ignored"]
+fn notebook14_nelder_mead_acceptance() {
+    let scene = load(std::path::Path::new("scenes/notebook14/scene.toml"));
+    let opts = OptimizeOptions {
+        method: Method::NelderMead,
+        edge_margin_mm: 6.0,
+        verify_photons: 20_000_000,
+        ..OptimizeOptions::default()
+    };
+    let r = optimize(&scene, &opts, &mut |it| println!("{it}")).unwrap();
+    let v = r.verification.unwrap();
+    let s = &v.final_design.summary;
+    println!("{:?}", s.uniformity);
+    assert!(s.uniformity.thirteen_point_min_over_max >= 0.8);
+    assert!(v.final_design.evaluation.area_cv < 0.10);
+}
+
+/// Acceptance on notebook14 (minutes): the feedback method.
+#[test]
+#[ignore = "minutes: cargo test --release --test optimize -- --ignored"]
+fn notebook14_feedback_acceptance() {
+    let scene = load(std::path::Path::new("scenes/notebook14/scene.toml"));
+    let opts = OptimizeOptions {
+        method: Method::Feedback,
+        max_iter: 15,
+        smoothing: 0.3,
+        edge_margin_mm: 6.0,
+        verify_photons: 20_000_000,
+        ..OptimizeOptions::default()
+    };
+    let r = optimize(&scene, &opts, &mut |it| println!("{it}")).unwrap();
+    let v = r.verification.unwrap();
+    let e = &v.final_design.evaluation;
+    let debiased = (e.area_cv.powi(2) - e.area_noise_floor.powi(2))
+        .max(0.0)
+        .sqrt();
+    assert!(
+        debiased < 0.05,
+        "area cv {} (floor {})",
+        e.area_cv,
+        e.area_noise_floor
+    );
+    assert!(
+        v.final_design
+            .summary
+            .uniformity
+            .thirteen_point_min_over_max
+            >= 0.8
+    );
+}

@@ -1,0 +1,467 @@
+//! `direct-lit`: a direct-lit (bottom-lit) backlight: a row of CCFLs in a white reflective
+//! box behind a diffuser plate. Lamp count, spacing, height and the back reflector's
+//! shape are parameters ([`DirectLit`]), so an optimizer can generate and trace variants;
+//! the bundled `direct-lit` scene and the test variants `test/direct-lit-3` and
+//! `test/direct-lit-8` are instances.
+//!
+//! ```no_run
+//! use scenegen::scenes::direct_lit::{DirectLit, Reflector};
+//! let variant = DirectLit { lamps: 4, pitch: 90.0, reflector: Reflector::Ridges { height: 6.0 }, ..DirectLit::bundled() };
+//! for f in variant.files("my-variant") {
+//!     std::fs::write(&f.path, &f.bytes).unwrap(); // paths start with the folder name
+//! }
+//! ```
+
+use super::{GENERATED, trace_table};
+use crate::{
+    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
+    write_mtl, write_obj,
+};
+
+/// Inner box length along x, across the lamps (mm).
+pub const BOX_X: f64 = 400.0;
+/// Inner box width along y, along the lamps (mm).
+pub const BOX_Y: f64 = 250.0;
+/// Box depth: from the back reflector's lowest point (z = 0) to the diffuser plate (mm).
+pub const DEPTH: f64 = 25.0;
+/// Diffuser plate thickness (mm); the plate spans z = DEPTH..DEPTH + this.
+pub const PLATE_T: f64 = 2.0;
+/// Diffuser plate refractive index (polycarbonate).
+pub const N_PLATE: f64 = 1.585;
+/// Diffuser plate absorption (1/mm).
+pub const PLATE_ABSORPTION: f64 = 0.001;
+/// CCFL radius (mm).
+pub const LAMP_R: f64 = 1.5;
+/// Clearance between each lamp's ends and the box's end walls (mm).
+pub const LAMP_END_CLEARANCE: f64 = 5.0;
+/// Radiant power per lamp (W).
+pub const LAMP_POWER_W: f64 = 1.0;
+/// Albedo of the white box walls and back reflector (Lambertian).
+pub const WALL_ALBEDO: f64 = 0.95;
+/// Detector height above the diffuser plate's top face (mm).
+pub const DETECTOR_GAP: f64 = 0.5;
+/// Default GGX roughness (alpha) of the diffuser plate's two large faces.
+pub const DIFFUSER_ROUGHNESS: f64 = 0.6;
+/// The geometry file's name in every variant's folder.
+pub const OBJ: &str = "direct-lit.obj";
+/// Its display-material library.
+pub const MTL: &str = "direct-lit.mtl";
+
+/// The back reflector's shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reflector {
+    /// A flat back at z = 0.
+    Flat,
+    /// Triangular ridges: valleys (z = 0) under the lamps, straight slopes up to ridges of
+    /// `height` midway between neighbouring lamps and at the side walls.
+    Ridges {
+        /// Ridge height above the valleys (mm).
+        height: f64,
+    },
+}
+
+/// The parameters of a direct-lit box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DirectLit {
+    /// Scene name.
+    pub name: String,
+    /// Number of lamps (at least 1).
+    pub lamps: usize,
+    /// Lamp spacing, centre to centre (mm); the row is centred in the box.
+    pub pitch: f64,
+    /// Lamp axis height above z = 0 (mm).
+    pub lamp_height: f64,
+    /// Back reflector shape.
+    pub reflector: Reflector,
+    /// GGX roughness of the diffuser plate's two large faces (model `diffuser`; 0 is a
+    /// clear plate).
+    pub diffuser_roughness: f64,
+    /// Flux bins (x, y).
+    pub bins: [usize; 2],
+    /// Default photon count.
+    pub photons: u64,
+}
+
+impl DirectLit {
+    /// The bundled `direct-lit` scene: 6 lamps at the box's natural pitch (`BOX_X / 6`),
+    /// 8 mm up, over 6 mm ridges.
+    pub fn bundled() -> Self {
+        Self::evenly_spaced("direct-lit", 6)
+    }
+
+    /// `lamps` lamps spaced `BOX_X / lamps` (each owns an equal strip of the box), 8 mm
+    /// up, over 6 mm ridges, under a plate of roughness [`DIFFUSER_ROUGHNESS`]; 80 x 50
+    /// bins of 5 mm.
+    pub fn evenly_spaced(name: &str, lamps: usize) -> Self {
+        Self {
+            name: name.to_string(),
+            lamps,
+            pitch: BOX_X / lamps as f64,
+            lamp_height: 8.0,
+            reflector: Reflector::Ridges { height: 6.0 },
+            diffuser_roughness: DIFFUSER_ROUGHNESS,
+            bins: [80, 50],
+            photons: 400_000,
+        }
+    }
+
+    /// Lamp axis x positions.
+    pub fn lamp_x(&self) -> Vec<f64> {
+        let n = self.lamps as f64;
+        (0..self.lamps)
+            .map(|i| 0.5 * BOX_X + (i as f64 - 0.5 * (n - 1.0)) * self.pitch)
+            .collect()
+    }
+
+    /// Lamp centres (the lamps run along y).
+    pub fn lamp_centres(&self) -> Vec<P3> {
+        self.lamp_x()
+            .into_iter()
+            .map(|x| [x, 0.5 * BOX_Y, self.lamp_height])
+            .collect()
+    }
+
+    /// Lamp length: the box width less the end clearances.
+    pub fn lamp_length(&self) -> f64 {
+        BOX_Y - 2.0 * LAMP_END_CLEARANCE
+    }
+
+    /// The back reflector's profile (x, z), from x = 0 to `BOX_X`.
+    pub fn back_profile(&self) -> Vec<[f64; 2]> {
+        match self.reflector {
+            Reflector::Flat => vec![[0.0, 0.0], [BOX_X, 0.0]],
+            Reflector::Ridges { height } => {
+                let xs = self.lamp_x();
+                let mut p = vec![[0.0, height]];
+                for (i, &x) in xs.iter().enumerate() {
+                    if i > 0 {
+                        p.push([0.5 * (xs[i - 1] + x), height]);
+                    }
+                    p.push([x, 0.0]);
+                }
+                p.push([BOX_X, height]);
+                p
+            }
+        }
+    }
+
+    /// Check the parameters: the lamps fit in the box, clear of the walls, the ridges and
+    /// each other, below the plate.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.lamps == 0 {
+            return Err("needs at least one lamp".into());
+        }
+        if !(self.diffuser_roughness >= 0.0 && self.diffuser_roughness.is_finite()) {
+            return Err(format!(
+                "diffuser roughness {}: must be >= 0",
+                self.diffuser_roughness
+            ));
+        }
+        let pitch_ok = self.pitch.is_finite() && self.pitch > 2.0 * LAMP_R + 1.0;
+        if self.lamps > 1 && !pitch_ok {
+            return Err(format!("pitch {} mm: lamps would touch", self.pitch));
+        }
+        let xs = self.lamp_x();
+        if xs[0] - LAMP_R < 1.0 || xs[xs.len() - 1] + LAMP_R > BOX_X - 1.0 {
+            return Err(format!(
+                "{} lamps at {} mm pitch do not fit in the {BOX_X} mm box",
+                self.lamps, self.pitch
+            ));
+        }
+        if self.lamp_height + LAMP_R > DEPTH - 1.0 {
+            return Err(format!(
+                "lamp height {} mm: too close to the plate",
+                self.lamp_height
+            ));
+        }
+        if let Reflector::Ridges { height } = self.reflector
+            && !(0.0..DEPTH - 1.0).contains(&height)
+        {
+            return Err(format!(
+                "ridge height {height} mm: must be within 0..{}",
+                DEPTH - 1.0
+            ));
+        }
+        // Clearance from every lamp to every back profile segment.
+        let prof = self.back_profile();
+        for &x in &xs {
+            for w in prof.windows(2) {
+                let d = point_segment([x, self.lamp_height], w[0], w[1]);
+                if d < LAMP_R + 1.0 {
+                    return Err(format!(
+                        "the lamp at x = {x} mm comes within {:.2} mm of the back reflector",
+                        d - LAMP_R
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The parts: white box (back reflector and four walls) and diffuser plate.
+    pub fn parts(&self) -> Vec<Part> {
+        let prof = self.back_profile();
+        let (y1, top) = (BOX_Y, DEPTH);
+        let t = "box_reflector";
+        let mut bx = Part::new("box");
+        // Back: one strip per profile segment, normals up (into the box).
+        for w in prof.windows(2) {
+            let ([xa, za], [xb, zb]) = (w[0], w[1]);
+            bx.quad(t, [xa, 0.0, za], [xb, 0.0, zb], [xb, y1, zb], [xa, y1, za]);
+        }
+        // Side walls x = 0 and x = BOX_X, from the profile's ends up to the plate.
+        let (z0, z1) = (prof[0][1], prof[prof.len() - 1][1]);
+        bx.quad(
+            t,
+            [0.0, 0.0, z0],
+            [0.0, y1, z0],
+            [0.0, y1, top],
+            [0.0, 0.0, top],
+        );
+        bx.quad(
+            t,
+            [BOX_X, 0.0, z1],
+            [BOX_X, 0.0, top],
+            [BOX_X, y1, top],
+            [BOX_X, y1, z1],
+        );
+        // End walls y = 0 and y = BOX_Y: a trapezoid over each profile segment.
+        for w in prof.windows(2) {
+            let ([xa, za], [xb, zb]) = (w[0], w[1]);
+            bx.quad(
+                t,
+                [xa, 0.0, za],
+                [xa, 0.0, top],
+                [xb, 0.0, top],
+                [xb, 0.0, zb],
+            );
+            bx.quad(t, [xa, y1, za], [xb, y1, zb], [xb, y1, top], [xa, y1, top]);
+        }
+        let mut plate = Part::new("diffuser");
+        hexahedron(
+            &mut plate,
+            &box_corners([0.0, 0.0, DEPTH], [BOX_X, BOX_Y, DEPTH + PLATE_T]),
+            "diffuser_top",
+            "diffuser_back",
+            "diffuser_edge",
+        );
+        vec![bx, plate]
+    }
+
+    fn scene_toml(&self, triangles: usize) -> String {
+        let reflector = match self.reflector {
+            Reflector::Flat => "flat, at z = 0".to_string(),
+            Reflector::Ridges { height } => format!(
+                "triangular ridges {} high: valleys (z = 0) under the lamps,
+  ridges midway between neighbouring lamps and at the x walls",
+                dim(height)
+            ),
+        };
+        let xs: Vec<String> = self.lamp_x().iter().map(|&x| dim(x)).collect();
+        let header = format!(
+            "{name}: a direct-lit backlight: {n} CCFLs in a white reflective box behind a diffuser plate.
+{GENERATED}
+Made by tools/scenegen's DirectLit (lamp count, spacing, height and back reflector shape
+are parameters).
+
+Axes (mm): x across the lamps, y along them, z towards the viewer.
+
+- Box (tag box_reflector, Lambertian, albedo {WALL_ALBEDO}, like white PET): inner
+  {BOX_X} x {BOX_Y}, {DEPTH} deep from z = 0 to the diffuser plate; four side walls up to
+  the plate.
+- Back reflector (same tag): {reflector}.
+- Lamps: {n} CCFLs along y, radius {LAMP_R}, length {len} ({LAMP_END_CLEARANCE} clear of each
+  end wall), {LAMP_POWER_W} W each, axes at z = {h}, pitch {pitch}, at
+  x = {xs}.
+- Diffuser plate: polycarbonate (n = {N_PLATE}, absorption {PLATE_ABSORPTION} /mm), {BOX_X} x {BOX_Y} x {PLATE_T}
+  at z = {DEPTH}..{ztop}, resting on the walls. Tags diffuser_top (the front face),
+  diffuser_back, diffuser_edge (smooth). Its two large faces are rough dielectric
+  interfaces (model diffuser, GGX roughness {rough}): a surface-scattering stand-in for a
+  bulk-diffusing plate, which blutrace cannot model (no volume scattering).
+- Detector: {DETECTOR_GAP} above the plate (z = {zd}), covering it, {bx} x {by} bins.
+
+Geometry: {obj} (tags are its usemtl names), {triangles} triangles.
+",
+            name = self.name,
+            n = self.lamps,
+            len = dim(self.lamp_length()),
+            h = dim(self.lamp_height),
+            xs = xs.join(", "),
+            pitch = dim(self.pitch),
+            ztop = dim(DEPTH + PLATE_T),
+            rough = num(self.diffuser_roughness),
+            zd = dim(DEPTH + PLATE_T + DETECTOR_GAP),
+            bx = self.bins[0],
+            by = self.bins[1],
+            obj = OBJ,
+        );
+        let mut s = comment(&header);
+        s += &format!(
+            "
+version = 1
+name = \"{name}\"
+description = \"Direct-lit BLU: {n} CCFLs at {pitch} mm pitch in a {BOX_X} x {BOX_Y} x {DEPTH} mm white box behind a {PLATE_T} mm plate\"
+
+[[geometry]]
+file = \"{obj}\"
+
+[media.pc]
+n = {np}
+absorption_per_mm = {PLATE_ABSORPTION}
+
+[surfaces.box_reflector]
+model = \"lambert\"
+albedo = {WALL_ALBEDO}
+
+[surfaces.diffuser_top]
+model = \"diffuser\"
+inside = \"pc\"
+roughness = {rough}
+
+[surfaces.diffuser_back]
+model = \"diffuser\"
+inside = \"pc\"
+roughness = {rough}
+
+[surfaces.diffuser_edge]
+model = \"dielectric\"
+inside = \"pc\"
+",
+            name = self.name,
+            n = self.lamps,
+            pitch = dim(self.pitch),
+            obj = OBJ,
+            np = num(N_PLATE),
+            rough = num(self.diffuser_roughness),
+        );
+        for (i, c) in self.lamp_centres().iter().enumerate() {
+            s += &format!(
+                "
+[[sources]]
+type = \"ccfl\"
+name = \"lamp{}\"
+center = {}
+axis = [0.0, 1.0, 0.0]
+radius_mm = {}
+length_mm = {}
+power_w = {}
+",
+                i + 1,
+                arr(c),
+                num(LAMP_R),
+                num(self.lamp_length()),
+                num(LAMP_POWER_W)
+            );
+        }
+        s += &format!(
+            "
+[detector]
+origin = {}
+u = [1.0, 0.0, 0.0]
+v = [0.0, 1.0, 0.0]
+size_mm = {}
+bins = [{}, {}]
+angular_bins = [18, 36]
+
+{}",
+            arr(&[0.0, 0.0, DEPTH + PLATE_T + DETECTOR_GAP]),
+            arr(&[BOX_X, BOX_Y]),
+            self.bins[0],
+            self.bins[1],
+            trace_table(self.photons, 100_000)
+        );
+        s
+    }
+
+    /// The scene's files below `folder` (e.g. `direct-lit` or `test/direct-lit-3`):
+    /// `scene.toml`, [`OBJ`] and its `.mtl`.
+    /// Panics if [`DirectLit::validate`] fails.
+    pub fn files(&self, folder: &str) -> Vec<GenFile> {
+        if let Err(e) = self.validate() {
+            panic!("{}: {e}", self.name);
+        }
+        let parts = self.parts();
+        let triangles = parts.iter().map(Part::triangle_count).sum();
+        let header = format!(
+            "{}: direct-lit backlight, {} lamps (see scene.toml). Units mm.\n{GENERATED}",
+            self.name, self.lamps
+        );
+        let mtl_header =
+            format!("{header}\nDisplay colours only: blutrace reads the usemtl names as tags.");
+        vec![
+            GenFile::text(&format!("{folder}/scene.toml"), self.scene_toml(triangles)),
+            GenFile::text(
+                &format!("{folder}/{OBJ}"),
+                write_obj(&header, &parts, ObjTags::Usemtl(MTL)),
+            ),
+            GenFile::text(
+                &format!("{folder}/{MTL}"),
+                write_mtl(&mtl_header, &tags_of(&parts)),
+            ),
+        ]
+    }
+}
+
+/// Distance from point `p` to segment `a b` in the xz plane.
+fn point_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dz) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dz * dz;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dz) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dz)
+}
+
+/// The bundled scene and the test variants (3 and 8 lamps) used by
+/// `tests/variants.rs` to check that more lamps make the light more uniform.
+pub fn files() -> Vec<GenFile> {
+    let mut f = DirectLit::bundled().files("direct-lit");
+    let mut three = DirectLit::evenly_spaced("test-direct-lit-3", 3);
+    let mut eight = DirectLit::evenly_spaced("test-direct-lit-8", 8);
+    for v in [&mut three, &mut eight] {
+        v.photons = 100_000;
+    }
+    f.extend(three.files("test/direct-lit-3"));
+    f.extend(eight.files("test/direct-lit-8"));
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundled_and_test_variants_validate() {
+        for n in 1..=12 {
+            DirectLit::evenly_spaced("x", n).validate().unwrap();
+        }
+        let crowded = DirectLit {
+            pitch: 2.0,
+            ..DirectLit::bundled()
+        };
+        assert!(crowded.validate().is_err());
+        let wide = DirectLit {
+            pitch: 100.0,
+            ..DirectLit::bundled()
+        };
+        assert!(wide.validate().unwrap_err().contains("do not fit"));
+    }
+
+    #[test]
+    fn ridges_peak_between_lamps() {
+        let d = DirectLit::evenly_spaced("x", 4);
+        let p = d.back_profile();
+        assert_eq!(p.len(), 2 * 4 + 1);
+        assert_eq!(p[0], [0.0, 6.0]);
+        assert_eq!(p[1], [50.0, 0.0]);
+        assert_eq!(p[2], [100.0, 6.0]);
+        assert_eq!(p[8], [BOX_X, 6.0]);
+        let flat = DirectLit {
+            reflector: Reflector::Flat,
+            ..d
+        };
+        assert_eq!(flat.parts()[0].triangle_count(), 2 + 4 + 4);
+    }
+}

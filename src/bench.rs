@@ -9,11 +9,14 @@
 //! split into about 200k triangles (same surfaces, so the same physics). For each backend
 //! (with and without the convex-solid fast path) it traces the same photons and reports
 //! rates and the ratio to obvhs. A second table times nearest-hit queries of rays inside
-//! the light guide alone: the convex path against each backend.
+//! the light guide alone: the convex path against each backend. A third table gives the
+//! error reached in a fixed tracing time per backend and estimator, with the figure of
+//! merit `1 / (error^2 * seconds)`.
 
 use crate::accel::{self, Accel, BackendChoice};
 use crate::geometry::Ray;
 use crate::optics::sampling;
+use crate::optics::surface::Estimator;
 use crate::rng::PhotonRng;
 use crate::run::{self, RunOptions};
 use crate::scene::Scene;
@@ -138,6 +141,64 @@ pub fn in_guide_table(scene_dir: &Path, queries: usize) -> Result<Vec<(String, f
         rate(&rays, |r| solid.exit(&scene.mesh, r).map_or(0, |h| h.prim)),
     ));
     Ok(out)
+}
+
+/// One row of the error-against-time table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ErrorRow {
+    /// Backend name.
+    pub backend: String,
+    /// Estimator.
+    pub estimator: Estimator,
+    /// Photons traced in the time budget.
+    pub photons: u64,
+    /// Tracing seconds.
+    pub seconds: f64,
+    /// Relative standard error of the mean flux.
+    pub mean_rel_error: f64,
+    /// Mean relative standard error of the bins.
+    pub bin_rel_error: f64,
+    /// 1 / (err^2 t) for the mean flux.
+    pub fom_mean: f64,
+    /// 1 / (err^2 t) for the bins.
+    pub fom_bins: f64,
+}
+
+/// Error reached in `seconds` of tracing on `scene_dir`, per backend and estimator.
+pub fn error_table(
+    scene_dir: &Path,
+    seconds: f64,
+    threads: Option<usize>,
+) -> Result<Vec<ErrorRow>> {
+    let scene = Scene::load(&scene_dir.join("scene.toml"))?;
+    let mut rows = Vec::new();
+    for backend in backends() {
+        for estimator in [Estimator::Analog, Estimator::Weighted] {
+            let o = RunOptions {
+                photons: u64::MAX / 2,
+                max_time_s: Some(seconds),
+                threads,
+                backend,
+                estimator,
+                ..RunOptions::default()
+            };
+            let r = run::trace(&scene, &o, &|_| {})?;
+            let s = r.summary();
+            let mean_rel = s.uniformity_stderr.mean / s.uniformity.mean;
+            let t = s.runtime_s;
+            rows.push(ErrorRow {
+                backend: r.backend.into(),
+                estimator,
+                photons: s.photons,
+                seconds: t,
+                mean_rel_error: mean_rel,
+                bin_rel_error: s.mean_rel_stderr,
+                fom_mean: 1.0 / (mean_rel * mean_rel * t),
+                fom_bins: 1.0 / (s.mean_rel_stderr * s.mean_rel_stderr * t),
+            });
+        }
+    }
+    Ok(rows)
 }
 
 /// Queries per second of `f` over `rays`, single-threaded.

@@ -310,6 +310,24 @@ fn bench(scene: &Path, photons: u64, threads: Option<usize>) -> Result<()> {
     for (name, q) in &table {
         println!("| {name} | {q:.0} | {:.2} |", convex / q);
     }
+    println!();
+    let rows = blutrace::bench::error_table(scene, 4.0, threads)?;
+    println!(
+        "| backend | estimator | photons in ~4 s | mean-flux error | per-bin error | FOM mean | FOM bins |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|");
+    for r in rows {
+        println!(
+            "| {} | {:?} | {} | {:.2e} | {:.3} | {:.3e} | {:.3e} |",
+            r.backend,
+            r.estimator,
+            r.photons,
+            r.mean_rel_error,
+            r.bin_rel_error,
+            r.fom_mean,
+            r.fom_bins
+        );
+    }
     Ok(())
 }
 

@@ -560,7 +560,7 @@ fn degenerate_mesh() -> Mesh {
         for j in 0..n {
             for i in 0..n {
                 let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
-                if (i + j + layer as u32) % 2 == 0 {
+                if (i + j + layer as u32).is_multiple_of(2) {
                     triangles.push([a, b, d]);
                     triangles.push([a, d, c]);
                 } else {

@@ -340,3 +340,26 @@ fn convex_fast_path_gives_the_same_fates_and_tallies_as_the_mesh_path() {
         "flux maps differ: chi-square {chi2:.0} over 10000 bins"
     );
 }
+
+#[test]
+fn lambertian_source_gives_uniform_luminance_equal_to_flux_over_pi_area() {
+    // All light of a Lambertian emitter crosses a huge target: the target's luminance is
+    // the same at every viewing angle and equals lumens / (pi * area).
+    let toml = "version = 1\ngeometry = []\nsurfaces = {}\n\
+        [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\nu = [1.0, 0.0, 0.0]\n\
+        width_mm = 1e-3\nheight_mm = 1e-3\npower_w = 1.0\nlumens = 100.0\n\
+        [detector]\norigin = [-1e7, -1e7, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [2e7, 2e7]\n\
+        bins = [4, 4]\nangular_bins = [9, 4]\n";
+    let scene = load(&write_scene("luminance", toml, &[]));
+    let r = trace(&scene, 200_000, 8, 2);
+    let lum = r.summary().luminance.expect("sources give lumens");
+    let area_m2 = 2e7 * 2e7 * 1e-6;
+    let expected = 100.0 / (std::f64::consts::PI * area_m2);
+    assert!((lum.efficacy_lm_per_w - 100.0).abs() < 1e-12);
+    for [theta, value, se] in lum.by_theta {
+        assert!(
+            (value - expected).abs() < 4.0 * se,
+            "theta {theta}: {value:.4e} ± {se:.1e}, expected {expected:.4e}"
+        );
+    }
+}

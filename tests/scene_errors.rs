@@ -154,7 +154,7 @@ fn open_solid_is_refused() {
     let path = write_scene("open", GOOD, &[("plate.obj", &obj)]);
     let msg = format!(
         "{:#}",
-        Scene::load(&path).err().expect("open solid must not load")
+        Scene::load(&path).expect_err("open solid must not load")
     );
     assert_mentions(&msg, &["medium 'pmma'", "not enclosed", "open"]);
 }

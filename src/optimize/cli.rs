@@ -33,10 +33,10 @@ pub struct OptimizeArgs {
     /// Stop once the objective (cv of the profile along the axis) is at or below this.
     #[arg(long)]
     pub target_cv: Option<f64>,
-    /// Seed shared by every evaluation (default: the scene's [trace] seed).
+    /// Seed shared by every evaluation (default: the scene's trace.seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Output folder (default: out/<scene name>-optimize-<method>).
+    /// Output folder (default: out/NAME-optimize-METHOD, NAME being the scene's name).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Degree of the density polynomial (default: the scene's, at least 3).

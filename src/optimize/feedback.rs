@@ -2,7 +2,7 @@
 //! after each trace.
 //!
 //! ```text
-//! blutrace optimize SCENE --method feedback [--alpha 0.7] [--smoothing 0.25] [--max-iter 12]
+//! blutrace optimize SCENE --method feedback [--alpha 0.7] [--smoothing 0.25] [--max-iter 15]
 //! ```
 //!
 //! Each round traces the current design and updates every knot by
@@ -11,8 +11,10 @@
 //! objective's margins (`--edge-margin-mm`; the median, not the mean, so a few strips that
 //! cannot be fixed, such as light leaking at a lamp edge, do not pull the level); then `d`
 //! is clamped to `[min printable, max packing]` and optionally smoothed with its
-//! neighbours. With mirrored patterns (lamps on
-//! both edges) the two halves share their knots, which halves the noise per knot.
+//! neighbours. The rounds stop at the objective bound (`--target-cv`), the iteration cap,
+//! or after [`STALL_ROUNDS`] rounds that gain less than the objective's noise. With
+//! mirrored patterns (lamps on both edges) the two halves share their knots, which halves
+//! the noise per knot.
 //!
 //! The result is written as a `density_table`:
 //!
@@ -23,6 +25,10 @@
 
 use super::objective::Profile;
 use crate::optics::dots::DotPattern;
+
+/// The search stops after this many rounds in a row that do not beat the best objective
+/// by more than its standard error (the design has converged to the noise level).
+pub const STALL_ROUNDS: usize = 3;
 
 /// Settings of one update.
 #[derive(Clone, Copy, Debug, PartialEq)]

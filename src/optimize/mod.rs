@@ -797,6 +797,7 @@ fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport))
     }
     let table = |d: &[f64]| Density::Table(knots.iter().zip(d).map(|(x, d)| [*x, *d]).collect());
     let mut iteration = 0;
+    let mut stalled = 0;
     loop {
         // Round 0 traces the scene's own density; later rounds the table.
         let density = if iteration == 0 {
@@ -804,7 +805,12 @@ fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport))
         } else {
             table(&d)
         };
+        let before = search.best.as_ref().map(|(_, b, _)| (b.objective, b.noise));
         let ev = search.evaluate(&density)?;
+        match before {
+            Some((b, noise)) if ev.objective > b - noise => stalled += 1,
+            _ => stalled = 0,
+        }
         let best = search
             .best
             .as_ref()
@@ -817,6 +823,11 @@ fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport))
         search.report(iteration, step.into(), d.clone(), &best, progress);
         if search.options.target_cv.is_some_and(|t| ev.objective <= t) {
             return Ok(format!("objective bound reached after {iteration} rounds"));
+        }
+        if stalled >= feedback::STALL_ROUNDS {
+            return Ok(format!(
+                "no gain beyond the objective's noise in {stalled} rounds, after {iteration} rounds"
+            ));
         }
         if iteration >= search.options.max_iter {
             return Ok(format!("iteration cap reached after {iteration} rounds"));

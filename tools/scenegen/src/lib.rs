@@ -253,6 +253,10 @@ pub struct LampHolder {
     pub y1: f64,
     /// Segments along the arc.
     pub segments: usize,
+    /// Height of the guide's back edge at `x = 0`. When set, a wall at `x = 0` from the
+    /// sheet up to it seals the air gap under the guide (as a lamp reflector taped to the
+    /// guide's back does), so lamp light enters the guide only through its edge face.
+    pub z_seal: Option<f64>,
 }
 
 impl LampHolder {
@@ -305,6 +309,17 @@ impl LampHolder {
             [0.0, y1, zh],
             [0.0, y0, zh],
         );
+        // Seal under the guide's edge, facing the lamps (-x).
+        if let Some(zs) = self.z_seal {
+            let ze = self.z_lo_edge;
+            p.quad(
+                tag,
+                [0.0, y0, ze],
+                [0.0, y0, zs],
+                [0.0, y1, zs],
+                [0.0, y1, ze],
+            );
+        }
         // End caps: a fan from the arc centre (the region is convex: a disc less a cap)
         // plus the air gap's quad; normals into the holder.
         let c = [self.xc, self.zc()];
@@ -611,6 +626,7 @@ mod tests {
             gap: 0.3,
             z_lo: -0.15,
             z_lo_edge: -0.15,
+            z_seal: None,
             z_hi: 3.0,
             xc: -2.35,
             y0: 0.0,

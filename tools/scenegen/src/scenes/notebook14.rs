@@ -44,6 +44,7 @@ pub fn holder() -> LampHolder {
         gap: LIP_GAP,
         z_lo: -SHEET_GAP,
         z_lo_edge: -SHEET_GAP,
+        z_seal: Some(0.0),
         z_hi: T,
         xc: -LAMP_INSET,
         y0: 0.0,
@@ -122,8 +123,10 @@ Not given by the paper, chosen as typical (lengths in mm):
   open towards the guide; its lips end {LIP_GAP} short of the edge face, the lower lip on the
   reflector sheet (z = {zs}), the upper lip at the front face's height (z = {T}) where a flat
   {LIP_GAP}-wide strip continues it to the edge of the front face; flat end caps at y = 0 and
-  y = {W} close the arc and the air gap in front of the edge. Phong: reflectance 0.95,
-  specular 0.8, exponent 100.
+  y = {W} close the arc and the air gap in front of the edge; a wall at x = 0 from the
+  sheet up to the back face seals the air gap under the guide (as a reflector taped to the
+  guide's back does), so lamp light enters the guide only through its edge face. Phong:
+  reflectance 0.95, specular 0.8, exponent 100.
 - Reflector sheet (tag reflector_sheet): z = {zs} ({SHEET_GAP} air gap below the back face),
   x {x0}..{x1}, y 0..{W}: the light guide's footprint plus the air gaps up to both lamp
   reflectors' lower lips, which it meets, so lamp light reaches the viewer only through

@@ -65,6 +65,7 @@ pub fn holder() -> LampHolder {
         gap: LIP_GAP,
         z_lo: sheet_z(-LIP_GAP),
         z_lo_edge: sheet_z(0.0),
+        z_seal: Some(0.0),
         z_hi: T0,
         xc: -LAMP_INSET,
         y0: 0.0,

@@ -165,16 +165,7 @@ pub struct DotPattern {
 impl DotPattern {
     /// The polynomial variable at distance `u` (mm) along the axis from the origin.
     pub fn x_of(&self, u: f64) -> f64 {
-        let u = u.clamp(0.0, self.length);
-        let (dist, span) = if self.mirror {
-            (u.min(self.length - u), 0.5 * self.length)
-        } else {
-            (u, self.length)
-        };
-        match self.x_unit {
-            XUnit::Normalized => dist / span,
-            XUnit::Mm => dist,
-        }
+        super::gradation::graded_x(u, self.length, self.x_unit, self.mirror)
     }
 
     /// The density (area fraction) at distance `u` (mm) along the axis.

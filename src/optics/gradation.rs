@@ -6,10 +6,25 @@
 //! lamps sit at both ends (`mirror`). [`super::grooves`] grades its groove fill fraction
 //! with it.
 //!
-//! (`DotPattern::x_of` in `dots.rs` is the same few lines; a test below checks the two
-//! agree, so dots can delegate here later without a change of behaviour.)
+//! Dots and grooves measure `x` with the same [`graded_x`].
 
 use super::dots::{Density, XUnit};
+
+/// The grading variable at distance `u` (mm) from the lamp edge along a span of `length`
+/// (mm): clamped to the span, from the nearer edge when `mirror`, in mm or normalized by
+/// the span (the half span when mirrored).
+pub fn graded_x(u: f64, length: f64, unit: XUnit, mirror: bool) -> f64 {
+    let u = u.clamp(0.0, length);
+    let (dist, span) = if mirror {
+        (u.min(length - u), 0.5 * length)
+    } else {
+        (u, length)
+    };
+    match unit {
+        XUnit::Normalized => dist / span,
+        XUnit::Mm => dist,
+    }
+}
 
 /// A function graded along an axis of span `length` (mm).
 #[derive(Clone, Debug, PartialEq)]
@@ -46,16 +61,7 @@ impl Gradation {
     /// The polynomial variable at distance `u` (mm) along the axis from the lamp edge
     /// (clamped to the span).
     pub fn x_of(&self, u: f64) -> f64 {
-        let u = u.clamp(0.0, self.length);
-        let (dist, span) = if self.mirror {
-            (u.min(self.length - u), 0.5 * self.length)
-        } else {
-            (u, self.length)
-        };
-        match self.x_unit {
-            XUnit::Normalized => dist / span,
-            XUnit::Mm => dist,
-        }
+        graded_x(u, self.length, self.x_unit, self.mirror)
     }
 
     /// The graded value at distance `u` (mm) along the axis.

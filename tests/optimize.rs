@@ -4,12 +4,12 @@
 
 mod support;
 
-use blutrace::optics::dots::{Density, DotPattern, Lattice, XUnit};
+use blutrace::optics::dots::{Density, DensityGrid, DotPattern, Lattice, XUnit};
 use blutrace::optimize::export::{self, Dot};
 use blutrace::optimize::nelder_mead::{self, Settings, Termination};
 use blutrace::optimize::{Method, OptimizeOptions, optimize};
 use blutrace::scene::Scene;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 use support::{box_obj, load, write_scene};
 
@@ -226,6 +226,93 @@ fn exported_dots_round_trip_to_the_density() {
     }
 }
 
+/// A 3 x 2 density grid over the 30 x 12 mm face of [`pattern`].
+fn grid_pattern() -> DotPattern {
+    pattern(
+        Lattice::Square,
+        Density::Grid(DensityGrid {
+            x_max: 1.0,
+            v_min: 0.0,
+            width: 12.0,
+            values: vec![vec![0.1, 0.3, 0.5], vec![0.2, 0.6, 0.1]],
+        }),
+    )
+}
+
+/// The grid of [`grid_pattern`] by hand: bilinear in (u / 15, v / 12).
+fn grid_by_hand(u: f64, v: f64) -> f64 {
+    let rows = [[0.1, 0.3, 0.5], [0.2, 0.6, 0.1]];
+    let fx = (u / 15.0).clamp(0.0, 2.0);
+    let i = (fx.floor() as usize).min(1);
+    let tx = fx - i as f64;
+    let ty = (v / 12.0).clamp(0.0, 1.0);
+    let row = |r: [f64; 3]| r[i] + (r[i + 1] - r[i]) * tx;
+    row(rows[0]) + (row(rows[1]) - row(rows[0])) * ty
+}
+
+#[test]
+fn density_grid_is_bilinear_at_cell_centres_and_covers_its_area_fraction() {
+    let p = grid_pattern();
+    assert_eq!(p.density.problem(), None);
+    assert_eq!(p.first_out_of_range(), None);
+    // Every exported dot is sized by the bilinear density at its own cell centre.
+    let dots = export::dots_on_face(&p, &rectangle());
+    assert!(dots.len() > 1000);
+    for d in &dots {
+        let want = grid_by_hand(d.x, d.y);
+        let r = Lattice::Square.dot_radius(0.5, want);
+        assert!(
+            (d.diameter - 2.0 * r).abs() < 1e-9,
+            "dot at ({}, {}): diameter {} for d = {want}",
+            d.x,
+            d.y,
+            d.diameter
+        );
+        assert!((p.density_at_point(DVec2::new(d.x, d.y)) - want).abs() < 1e-12);
+    }
+    // The knots themselves, and beyond the grid the nearest edge value.
+    assert!((p.density_at_point(DVec2::new(15.0, 12.0)) - 0.6).abs() < 1e-12);
+    assert!((p.density_at_point(DVec2::new(40.0, -3.0)) - 0.5).abs() < 1e-12);
+    // Covered area fraction of 3 x 3 mm patches (whole cells) = the density there (the
+    // mean of a bilinear function over a patch within one grid cell is its centre value).
+    for (u0, v0) in [
+        (1.0, 1.0),
+        (6.0, 7.0),
+        (16.0, 2.0),
+        (24.0, 8.5),
+        (11.5, 4.0),
+    ] {
+        let n = 300;
+        let mut inside = 0usize;
+        for i in 0..n {
+            for j in 0..n {
+                let x = u0 + 3.0 * (i as f64 + 0.5) / n as f64;
+                let y = v0 + 3.0 * (j as f64 + 0.5) / n as f64;
+                inside += p.covers(DVec3::new(x, y, 0.0)) as usize;
+            }
+        }
+        let got = inside as f64 / (n * n) as f64;
+        let want = grid_by_hand(u0 + 1.5, v0 + 1.5);
+        assert!(
+            (got - want).abs() < 0.01,
+            "patch at ({u0}, {v0}): covered {got:.4}, d = {want:.4}"
+        );
+    }
+    // A grid checks its shape and values.
+    let bad = |values: Vec<Vec<f64>>| {
+        Density::Grid(DensityGrid {
+            x_max: 1.0,
+            v_min: 0.0,
+            width: 12.0,
+            values,
+        })
+        .problem()
+    };
+    assert!(bad(vec![vec![0.1, 0.2], vec![0.3]]).is_some());
+    assert!(bad(vec![vec![0.1, f64::NAN]]).is_some());
+    assert!(bad(vec![]).is_some());
+}
+
 #[test]
 fn svg_and_dxf_hold_every_dot() {
     let p = pattern(Lattice::Hex, Density::Polynomial(vec![0.2]));
@@ -253,6 +340,18 @@ const LED: &str = "[[sources]]\ntype = \"led\"\ncenter = [-20.001, 0.0, 0.0]\nno
                    u = [0.0, 1.0, 0.0]\nwidth_mm = 10.0\nheight_mm = 0.9\npower_w = 1.0\n";
 
 /// A 40 x 10 x 1 mm PMMA plate lit from its -x end, dots on the back face.
+/// The dot pattern of the scene's (first) dots surface.
+fn dots_of(scene: &Scene) -> &DotPattern {
+    scene
+        .surfaces
+        .iter()
+        .find_map(|s| match s {
+            blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
+            _ => None,
+        })
+        .expect("the scene has a dots surface")
+}
+
 fn small_scene(name: &str, density: &str) -> std::path::PathBuf {
     let obj = box_obj(
         [-20.0, -5.0, -0.5],
@@ -277,14 +376,7 @@ fn density_table_in_scene_files() {
         "opt-table",
         "density_table = [[0.0, 0.1], [0.5, 0.3], [1.0, 0.2]]",
     ));
-    let dots = table
-        .surfaces
-        .iter()
-        .find_map(|s| match s {
-            blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
-            _ => None,
-        })
-        .unwrap();
+    let dots = dots_of(&table);
     assert!((dots.density_at(10.0) - 0.2).abs() < 1e-12);
     let both = small_scene(
         "opt-both",
@@ -292,7 +384,7 @@ fn density_table_in_scene_files() {
     );
     let msg = format!("{:#}", Scene::load(&both).unwrap_err());
     assert!(
-        msg.contains("surfaces.dots.density") && msg.contains("not both"),
+        msg.contains("surfaces.dots.density") && msg.contains("only one of"),
         "{msg}"
     );
     let neither = small_scene("opt-neither", "");
@@ -313,6 +405,52 @@ fn density_table_in_scene_files() {
         msg.contains("density_table") && msg.contains("packing"),
         "{msg}"
     );
+}
+
+#[test]
+fn density_grid_in_scene_files() {
+    let grid = load(&small_scene(
+        "opt-grid",
+        "density_grid = { width_mm = 10.0, v_min_mm = -5.0, values = [[0.1, 0.2], [0.3, 0.4]] }",
+    ));
+    let dots = dots_of(&grid);
+    assert!(matches!(&dots.density, Density::Grid(g) if g.x_max == 1.0 && g.shape() == (2, 2)));
+    // Mid-span, mid-width: the mean of the four knots.
+    assert!((dots.density_at_point(DVec2::new(20.0, 0.0)) - 0.25).abs() < 1e-12);
+    for (name, text, words) in [
+        (
+            "opt-grid-both",
+            "density = [0.1]\ndensity_grid = { width_mm = 10.0, values = [[0.1]] }",
+            &["surfaces.dots.density", "only one of"][..],
+        ),
+        (
+            "opt-grid-ragged",
+            "density_grid = { width_mm = 10.0, values = [[0.1, 0.2], [0.3]] }",
+            &["surfaces.dots.density_grid", "rectangular"][..],
+        ),
+        (
+            "opt-grid-nan",
+            "density_grid = { width_mm = 10.0, values = [[0.1, nan]] }",
+            &["surfaces.dots.density_grid", "finite"][..],
+        ),
+        (
+            "opt-grid-packing",
+            "density_grid = { width_mm = 10.0, values = [[0.1, 0.2], [0.3, 0.9]] }",
+            &["surfaces.dots.density_grid", "packing"][..],
+        ),
+        (
+            "opt-grid-width",
+            "density_grid = { width_mm = -1.0, values = [[0.1], [0.2]] }",
+            &["surfaces.dots.density_grid", "width_mm"][..],
+        ),
+    ] {
+        let path = small_scene(name, text);
+        let msg = format!("{:#}", Scene::load(&path).unwrap_err());
+        for w in words {
+            assert!(msg.contains(w), "{name}: {msg}");
+        }
+        assert!(msg.contains("scene.toml"), "{name}: {msg}");
+    }
 }
 
 fn small_options(method: Method) -> OptimizeOptions {
@@ -396,14 +534,7 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
         let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
         assert_eq!(history.lines().count(), r.history.len() + 1);
         let again = Scene::load(&out.join("optimized.toml")).unwrap();
-        let d = again
-            .surfaces
-            .iter()
-            .find_map(|s| match s {
-                blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
-                _ => None,
-            })
-            .unwrap();
+        let d = dots_of(&again);
         assert_eq!(d.density, r.final_density);
         let csv = std::fs::read_to_string(out.join("dots.csv")).unwrap();
         assert_eq!(export::parse_csv(&csv).unwrap().len(), r.dots.len());
@@ -509,4 +640,131 @@ fn notebook14_feedback_acceptance() {
             .thirteen_point_min_over_max
             >= 0.8
     );
+}
+
+/// cv (with its standard error) of the flux map's bins within `band` mm of the lamp edge
+/// along x (the phone-led detector starts at x = 2 with 1 mm bins).
+fn band_cv(map: &blutrace::run::metrics::Map, band: f64) -> (f64, f64) {
+    let (mut v, mut e) = (Vec::new(), Vec::new());
+    for iy in 0..map.ny {
+        for ix in 0..map.nx {
+            if 2.0 + ix as f64 + 0.5 < band {
+                v.push(map.value[iy * map.nx + ix]);
+                e.push(map.stderr[iy * map.nx + ix]);
+            }
+        }
+    }
+    let (cv, se, _) = blutrace::optimize::objective::cv_with_noise(&v, &e);
+    (cv, se)
+}
+
+/// phone-led (six side-view LEDs on a short edge: hot spots and dark corners, a 2-D
+/// non-uniformity): under the same budget the per-cell feedback over a density grid
+/// lowers the map's cv (debiased by its noise floor) and the cv of the 20 mm band in front
+/// of the LEDs more than the per-strip feedback does, by several standard errors.
+#[test]
+fn options_of_one_method_are_refused_by_the_other() {
+    let scene = load(std::path::Path::new("scenes/phone-led/scene.toml"));
+    let base = OptimizeOptions {
+        photons: 1000,
+        verify_photons: 0,
+        ..OptimizeOptions::default()
+    };
+    for (options, words) in [
+        (
+            OptimizeOptions {
+                method: Method::NelderMead,
+                dims: 2,
+                ..base.clone()
+            },
+            "--dims 2 needs --method feedback",
+        ),
+        (
+            OptimizeOptions {
+                method: Method::Feedback,
+                dims: 3,
+                ..base.clone()
+            },
+            "--dims must be 1 or 2",
+        ),
+        (
+            OptimizeOptions {
+                method: Method::Feedback,
+                cells: Some((4, 4)),
+                ..base.clone()
+            },
+            "--cells needs --method feedback --dims 2",
+        ),
+    ] {
+        let err = optimize(&scene, &options, &mut |_| {}).err();
+        let msg = format!("{:#}", err.expect("refused"));
+        assert!(msg.contains(words), "{msg}");
+    }
+}
+
+#[test]
+fn feedback_2d_beats_1d_on_phone_led() {
+    let scene = load(std::path::Path::new("scenes/phone-led/scene.toml"));
+    let base = OptimizeOptions {
+        method: Method::Feedback,
+        photons: 200_000,
+        seed: 1,
+        max_iter: 4,
+        verify_photons: 700_000,
+        ..OptimizeOptions::default()
+    };
+    let one = optimize(&scene, &base, &mut |_| {}).unwrap();
+    let two = optimize(
+        &scene,
+        &OptimizeOptions {
+            dims: 2,
+            cells: Some((12, 14)),
+            ..base.clone()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(matches!(&two.final_density, Density::Grid(g) if g.shape() == (12, 14)));
+    assert_eq!(one.photons, two.photons, "same budget");
+    let (v1, v2) = (
+        one.verification.as_ref().unwrap(),
+        two.verification.as_ref().unwrap(),
+    );
+    let map_cv = |v: &blutrace::optimize::VerifiedDesign| {
+        (v.summary.cv_debiased, v.summary.cv_debiased_stderr)
+    };
+    let (c0, e0) = map_cv(&v2.initial);
+    let (c1, e1) = map_cv(&v1.final_design);
+    let (c2, e2) = map_cv(&v2.final_design);
+    let band = |v: &blutrace::optimize::VerifiedDesign| band_cv(&v.evaluation.map, 20.0);
+    let (b0, f0) = band(&v2.initial);
+    let (b1, f1) = band(&v1.final_design);
+    let (b2, f2) = band(&v2.final_design);
+    println!(
+        "debiased map cv: initial {c0:.4} ± {e0:.4}, 1-D {c1:.4} ± {e1:.4}, 2-D {c2:.4} ± {e2:.4}; \
+         20 mm band cv: initial {b0:.4} ± {f0:.4}, 1-D {b1:.4} ± {f1:.4}, 2-D {b2:.4} ± {f2:.4}"
+    );
+    let sigma = (e1 * e1 + e2 * e2).sqrt();
+    assert!(
+        c2 < c1 - 3.0 * sigma,
+        "2-D {c2:.4} ± {e2:.4} vs 1-D {c1:.4} ± {e1:.4}"
+    );
+    assert!(c2 < c0 - 3.0 * (e0 * e0 + e2 * e2).sqrt());
+    assert!(
+        b2 < b1 - 3.0 * (f1 * f1 + f2 * f2).sqrt(),
+        "band: 1-D {b1:.4} ± {f1:.4}, 2-D {b2:.4} ± {f2:.4}"
+    );
+    assert!(
+        b2 < b0 - 3.0 * (f0 * f0 + f2 * f2).sqrt(),
+        "band: initial {b0:.4} ± {f0:.4}, 2-D {b2:.4} ± {f2:.4}"
+    );
+    // The written scene carries the grid as it is, and the grid gets its own map.
+    let out = std::env::temp_dir().join(format!("blutrace-opt-2d-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    two.write(&out).unwrap();
+    assert!(out.join("density_map.png").is_file());
+    let again = load(&out.join("optimized.toml"));
+    let reloaded = dots_of(&again);
+    assert_eq!(reloaded.density, two.final_density);
+    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -26,6 +26,18 @@
 //! ```toml
 //! density_table = [[0.0, 0.02], [0.5, 0.2], [1.0, 0.6]]
 //! ```
+//!
+//! For non-uniformity that varies across the axis too (LEDs on an edge, corner-lit
+//! guides), a density grid (what `blutrace optimize --method feedback --dims 2` writes)
+//! gives knots on a regular grid: `values[j][i]` is the density at `x = i / (nx - 1) x_max`
+//! (the polynomial variable as `x_unit` and `mirror` say; `x_max` is its value at the far
+//! end) and at `v = v_min_mm + j / (ny - 1) width_mm` across the axis (mm from `origin`
+//! along `across`); `d` is bilinear between knots, constant beyond the grid, and is
+//! evaluated at each dot cell's centre:
+//!
+//! ```toml
+//! density_grid = { width_mm = 68.0, values = [[0.02, 0.1, 0.5], [0.03, 0.12, 0.6]] }
+//! ```
 
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -83,14 +95,94 @@ pub enum Density {
     /// Knots `[x, d]`, `x` strictly increasing: linear between knots, constant beyond
     /// the first and the last.
     Table(Vec<[f64; 2]>),
+    /// Knots on a regular grid over the face (along the axis and across it), bilinear.
+    Grid(DensityGrid),
+}
+
+/// A density on a regular grid of knots: along the axis in the polynomial variable
+/// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DensityGrid {
+    /// The polynomial variable at the last column of knots.
+    pub x_max: f64,
+    /// Position across the axis (mm from the origin along `across`) of the first row.
+    pub v_min: f64,
+    /// Span across the axis (mm) from the first to the last row.
+    pub width: f64,
+    /// `values[j][i]`: row `j` across the axis, column `i` along it.
+    pub values: Vec<Vec<f64>>,
+}
+
+impl DensityGrid {
+    /// Columns (knots along the axis) and rows (across it).
+    pub fn shape(&self) -> (usize, usize) {
+        (self.values.first().map_or(0, Vec::len), self.values.len())
+    }
+
+    /// Fractional knot coordinates of `(x, v)`, clamped to the grid.
+    fn knot_coords(&self, x: f64, v: f64) -> (f64, f64) {
+        let (nx, ny) = self.shape();
+        let fx = if nx > 1 && self.x_max > 0.0 {
+            (x / self.x_max * (nx - 1) as f64).clamp(0.0, (nx - 1) as f64)
+        } else {
+            0.0
+        };
+        let fy = if ny > 1 && self.width > 0.0 {
+            ((v - self.v_min) / self.width * (ny - 1) as f64).clamp(0.0, (ny - 1) as f64)
+        } else {
+            0.0
+        };
+        (fx, fy)
+    }
+
+    /// The knot nearest to `(x, v)`: (column, row).
+    pub fn nearest_knot(&self, x: f64, v: f64) -> (usize, usize) {
+        let (fx, fy) = self.knot_coords(x, v);
+        (fx.round() as usize, fy.round() as usize)
+    }
+
+    /// Bilinear interpolation at `(x, v)`, constant beyond the grid.
+    pub fn at(&self, x: f64, v: f64) -> f64 {
+        let (nx, ny) = self.shape();
+        if nx == 0 || ny == 0 {
+            return 0.0;
+        }
+        let (fx, fy) = self.knot_coords(x, v);
+        let (i0, j0) = (
+            (fx.floor() as usize).min(nx - 1),
+            (fy.floor() as usize).min(ny - 1),
+        );
+        let (i1, j1) = ((i0 + 1).min(nx - 1), (j0 + 1).min(ny - 1));
+        let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+        let g = |i: usize, j: usize| self.values[j][i];
+        let a = g(i0, j0) + (g(i1, j0) - g(i0, j0)) * tx;
+        let b = g(i0, j1) + (g(i1, j1) - g(i0, j1)) * tx;
+        a + (b - a) * ty
+    }
+
+    /// The mean over the rows at `x` (the density averaged across the axis).
+    pub fn row_mean(&self, x: f64) -> f64 {
+        let (_, ny) = self.shape();
+        if ny == 0 {
+            return 0.0;
+        }
+        (0..ny)
+            .map(|j| {
+                let v = self.v_min + self.width * j as f64 / (ny - 1).max(1) as f64;
+                self.at(x, v)
+            })
+            .sum::<f64>()
+            / ny as f64
+    }
 }
 
 impl Density {
-    /// The density at the polynomial variable `x`.
+    /// The density at the polynomial variable `x` (a grid's mean across the axis).
     pub fn eval(&self, x: f64) -> f64 {
         match self {
             Density::Polynomial(c) => c.iter().rev().fold(0.0, |acc, c| acc * x + c),
             Density::Table(knots) => interpolate(knots, x),
+            Density::Grid(g) => g.row_mean(x),
         }
     }
 
@@ -116,6 +208,30 @@ impl Density {
                         i + 1
                     )
                 })
+            }
+            Density::Grid(g) => {
+                let (nx, ny) = g.shape();
+                if nx == 0 || ny == 0 {
+                    return Some("needs at least one row of values".into());
+                }
+                if let Some(j) = g.values.iter().position(|r| r.len() != nx) {
+                    return Some(format!(
+                        "values must be rectangular: row {j} has {} values, row 0 has {nx}",
+                        g.values[j].len()
+                    ));
+                }
+                if !(g.width.is_finite() && (g.width > 0.0 || ny == 1)) {
+                    return Some(format!("width_mm must be positive, got {}", g.width));
+                }
+                if !g.v_min.is_finite() {
+                    return Some("v_min_mm is not a finite number".into());
+                }
+                for (j, r) in g.values.iter().enumerate() {
+                    if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+                        return Some(format!("values[{j}][{i}] is not a finite number"));
+                    }
+                }
+                None
             }
         }
     }
@@ -187,6 +303,16 @@ impl DotPattern {
     /// span. Returns the first offending position (mm) and value.
     pub fn first_out_of_range(&self) -> Option<(f64, f64)> {
         let max = self.lattice.max_packing();
+        if let Density::Grid(g) = &self.density {
+            // Bilinear values lie between the knots': checking the knots is enough.
+            let (nx, _) = g.shape();
+            return g.values.iter().flatten().enumerate().find_map(|(k, &d)| {
+                let i = k % nx.max(1);
+                let u = self.length * i as f64 / (nx - 1).max(1) as f64;
+                let u = if self.mirror { 0.5 * u } else { u };
+                (!d.is_finite() || !(0.0..=max).contains(&d)).then_some((u, d))
+            });
+        }
         let samples = 4096;
         (0..=samples)
             .map(|i| self.length * i as f64 / samples as f64)
@@ -220,6 +346,21 @@ impl DotPattern {
     /// Radius (mm) of the dot centred at face coordinate `u` along the axis.
     pub fn dot_radius_at(&self, u: f64) -> f64 {
         self.lattice.dot_radius(self.pitch, self.density_at(u))
+    }
+
+    /// The density at face coordinates `c` (mm along `axis`, mm along `across`): a grid
+    /// uses both, the other densities only the first.
+    pub fn density_at_point(&self, c: DVec2) -> f64 {
+        match &self.density {
+            Density::Grid(g) => g.at(self.x_of(c.x), c.y),
+            _ => self.density_at(c.x),
+        }
+    }
+
+    /// Radius (mm) of the dot of the cell centred at face coordinates `c`.
+    pub fn dot_radius_at_cell(&self, c: DVec2) -> f64 {
+        self.lattice
+            .dot_radius(self.pitch, self.density_at_point(c))
     }
 
     /// In-face lattice coordinates of a point (mm along `axis`, mm along `across`).
@@ -257,7 +398,9 @@ impl DotPattern {
     pub fn covers(&self, p: DVec3) -> bool {
         let q = self.face_coords(p);
         let c = self.nearest_centre(q);
-        let r = self.lattice.dot_radius(self.pitch, self.density_at(c.x));
+        let r = self
+            .lattice
+            .dot_radius(self.pitch, self.density_at_point(c));
         q.distance_squared(c) < r * r
     }
 }

@@ -55,6 +55,7 @@ impl Gradation {
         match &self.density {
             Density::Polynomial(c) => c.iter().skip(1).all(|&c| c == 0.0),
             Density::Table(k) => k.iter().all(|p| p[1] == k[0][1]),
+            Density::Grid(g) => g.values.iter().flatten().all(|v| *v == g.values[0][0]),
         }
     }
 

@@ -63,6 +63,14 @@ pub struct OptimizeArgs {
     /// Feedback: weight of the neighbours' mean in a smoothing pass (0: none).
     #[arg(long, default_value_t = 0.25)]
     pub smoothing: f64,
+    /// Feedback: 1 (a table of knots along the axis) or 2 (a grid over the face, for
+    /// non-uniformity across the axis too, such as LEDs on an edge).
+    #[arg(long, default_value_t = 1)]
+    pub dims: usize,
+    /// Feedback with --dims 2: knots of the grid along and across the axis, as NX,NY
+    /// (default 56,28).
+    #[arg(long, value_parser = parse_cells)]
+    pub cells: Option<(usize, usize)>,
     /// Profile strips along the axis (default: the detector's bins along it).
     #[arg(long)]
     pub strips: Option<usize>,
@@ -87,6 +95,18 @@ pub struct OptimizeArgs {
     /// No per-iteration lines.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// `NX,NY` of `--cells`.
+fn parse_cells(s: &str) -> Result<(usize, usize), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts[..] {
+        [a, b] => match (a.parse::<usize>(), b.parse::<usize>()) {
+            (Ok(a), Ok(b)) if a >= 2 && b >= 2 => Ok((a, b)),
+            _ => Err(format!("expected NX,NY with both at least 2, got '{s}'")),
+        },
+        _ => Err(format!("expected NX,NY, got '{s}'")),
+    }
 }
 
 /// Accept a scene folder as well as the file itself.
@@ -119,6 +139,8 @@ impl OptimizeArgs {
             simplex_tol: self.simplex_tol,
             alpha: self.alpha,
             smoothing: self.smoothing,
+            dims: self.dims,
+            cells: self.cells,
             strips: self.strips,
             edge_margin_mm: self.edge_margin_mm,
             verify_photons: self.verify_photons,
@@ -138,10 +160,20 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
     }
     let options = args.options(&scene);
     let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from("out").join(format!("{}-optimize-{}", scene.name, options.method))
+        let two = options.method == Method::Feedback && options.dims == 2;
+        let suffix = if two { "-2d" } else { "" };
+        PathBuf::from("out").join(format!(
+            "{}-optimize-{}{suffix}",
+            scene.name, options.method
+        ))
     });
+    let objective = if options.method == Method::Feedback && options.dims == 2 {
+        "area cv of the flux map (2-D density grid)"
+    } else {
+        "cv of the flux profile along the axis"
+    };
     println!(
-        "optimize   {} ({}) by {}: {} photons per design, seed {}, objective = cv of the flux profile along the axis",
+        "optimize   {} ({}) by {}: {} photons per design, seed {}, objective = {objective}",
         scene.name,
         scene.path.display(),
         options.method,
@@ -217,6 +249,10 @@ pub fn print_report(r: &OptimizeResult) {
         }
         crate::optics::dots::Density::Table(k) => {
             println!("density    table of {} knots", k.len());
+        }
+        crate::optics::dots::Density::Grid(g) => {
+            let (nx, ny) = g.shape();
+            println!("density    grid of {nx} x {ny} knots (along x across)");
         }
     }
     println!("dots       {} on {}", r.dots.len(), r.tag);

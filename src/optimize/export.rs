@@ -64,7 +64,7 @@ pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Vec<Dot> 
         .map(|(_, _, c)| Dot {
             x: c.x,
             y: c.y,
-            diameter: 2.0 * pattern.dot_radius_at(c.x),
+            diameter: 2.0 * pattern.dot_radius_at_cell(c),
         })
         .filter(|d| d.diameter > 0.0)
         .collect()

@@ -16,7 +16,17 @@
 //! mirrored patterns (lamps on both edges) the two halves share their knots, which halves
 //! the noise per knot.
 //!
-//! The result is written as a `density_table`:
+//! With `--dims 2 [--cells NX,NY]` the density is a grid of `NX` x `NY` knots over the
+//! face (along the axis and across it, see [`crate::optics::dots`]), for non-uniformity
+//! that varies across the axis too (side-view LEDs, corner-lit guides): every knot is
+//! updated the same way from the mean flux of the map bins nearest to it, the target being
+//! the median over the knot cells, clamped, and optionally smoothed with a 3 x 3 kernel
+//! (`--smoothing` weighs the mean of the 8 neighbours). The rounds are judged, and the best
+//! design picked, by the area cv (the cv of the map's bins without the margins) instead of
+//! the profile's (debiased by its noise floor), and the result is written as a
+//! `density_grid`. The default grid is 56 x 28 knots.
+//!
+//! The 1-D result is written as a `density_table`:
 //!
 //! ```toml
 //! [surfaces.lgp_back]
@@ -24,7 +34,9 @@
 //! ```
 
 use super::objective::Profile;
-use crate::optics::dots::DotPattern;
+use crate::optics::dots::{Density, DensityGrid, DotPattern};
+use crate::run::metrics::Map;
+use crate::scene::Scene;
 
 /// The search stops after this many rounds in a row that do not beat the best objective
 /// by more than its standard error (the design has converged to the noise level).
@@ -110,6 +122,140 @@ pub fn update(pattern: &DotPattern, knots: &[f64], d: &mut [f64], profile: &Prof
                 .collect();
             let mean = nb.iter().sum::<f64>() / nb.len() as f64;
             d[j] = ((1.0 - s.smoothing) * old[j] + s.smoothing * mean).clamp(s.min, s.max);
+        }
+    }
+}
+
+/// The density grid the 2-D feedback starts from: `nx` x `ny` knots over the pattern's
+/// span of x and `v_min..=v_min + width` across, valued as `pattern`'s own density at each
+/// knot (clamped to `[min, max]`).
+pub fn initial_grid(
+    pattern: &DotPattern,
+    v_min: f64,
+    width: f64,
+    (nx, ny): (usize, usize),
+    min: f64,
+    max: f64,
+) -> DensityGrid {
+    let (nx, ny) = (nx.max(2), ny.max(2));
+    let x_max = pattern.x_max();
+    let values = (0..ny)
+        .map(|j| {
+            let v = v_min + width * j as f64 / (ny - 1) as f64;
+            (0..nx)
+                .map(|i| {
+                    let x = x_max * i as f64 / (nx - 1) as f64;
+                    let d = match &pattern.density {
+                        Density::Grid(g) => g.at(x, v),
+                        other => other.eval(x),
+                    };
+                    d.clamp(min, max)
+                })
+                .collect()
+        })
+        .collect();
+    DensityGrid {
+        x_max,
+        v_min,
+        width,
+        values,
+    }
+}
+
+/// Mean flux of the map's bins (of `scene`'s detector) nearest to each knot of `grid`
+/// (`[row][column]`; NaN where no bin falls). Bins outside the pattern's span are left out.
+pub fn measured_per_cell(
+    scene: &Scene,
+    pattern: &DotPattern,
+    grid: &DensityGrid,
+    map: &Map,
+) -> Vec<Vec<f64>> {
+    let (nx, ny) = grid.shape();
+    let mut sum = vec![vec![0.0; nx]; ny];
+    let mut count = vec![vec![0usize; nx]; ny];
+    let d = &scene.detector;
+    let (bx, by) = (d.size[0] / map.nx as f64, d.size[1] / map.ny as f64);
+    for iy in 0..map.ny {
+        for ix in 0..map.nx {
+            let centre = d.origin + d.u * ((ix as f64 + 0.5) * bx) + d.v * ((iy as f64 + 0.5) * by);
+            let q = pattern.face_coords(centre);
+            if !(0.0..pattern.length).contains(&q.x)
+                || q.y < grid.v_min
+                || q.y > grid.v_min + grid.width
+            {
+                continue;
+            }
+            let (i, j) = grid.nearest_knot(pattern.x_of(q.x), q.y);
+            sum[j][i] += map.value[iy * map.nx + ix];
+            count[j][i] += 1;
+        }
+    }
+    sum.iter()
+        .zip(&count)
+        .map(|(s, c)| {
+            s.iter()
+                .zip(c)
+                .map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN })
+                .collect()
+        })
+        .collect()
+}
+
+/// One 2-D feedback update of the grid's knots from the flux per knot cell: every knot
+/// gets `d <- d (target / measured)^alpha` with `target` the median over the cells, is
+/// clamped to `[min, max]`, then optionally smoothed with the mean of its (up to 8)
+/// neighbours in a 3 x 3 kernel.
+pub fn update_grid(grid: &mut DensityGrid, measured: &[Vec<f64>], s: &Settings) {
+    let mut all: Vec<f64> = measured
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|m| m.is_finite())
+        .collect();
+    if all.is_empty() {
+        return;
+    }
+    all.sort_by(f64::total_cmp);
+    let m = all.len() / 2;
+    let target = if all.len() % 2 == 1 {
+        all[m]
+    } else {
+        0.5 * (all[m - 1] + all[m])
+    };
+    if !(target > 0.0 && target.is_finite()) {
+        return;
+    }
+    for (row, mrow) in grid.values.iter_mut().zip(measured) {
+        for (dj, m) in row.iter_mut().zip(mrow) {
+            if m.is_nan() {
+                continue;
+            }
+            let ratio = if *m > 0.0 { target / m } else { 4.0 };
+            *dj = (*dj * ratio.clamp(0.25, 4.0).powf(s.alpha)).clamp(s.min, s.max);
+        }
+    }
+    let (nx, ny) = grid.shape();
+    if s.smoothing > 0.0 && nx * ny > 2 {
+        let old = grid.values.clone();
+        for j in 0..ny {
+            for i in 0..nx {
+                let (mut sum, mut n) = (0.0, 0usize);
+                let rows = j.saturating_sub(1)..=(j + 1).min(ny - 1);
+                for (jj, row) in old.iter().enumerate().filter(|(jj, _)| rows.contains(jj)) {
+                    let cols = i.saturating_sub(1)..=(i + 1).min(nx - 1);
+                    for (ii, v) in row.iter().enumerate().filter(|(ii, _)| cols.contains(ii)) {
+                        if (ii, jj) != (i, j) {
+                            sum += v;
+                            n += 1;
+                        }
+                    }
+                }
+                if n > 0 {
+                    let mean = sum / n as f64;
+                    grid.values[j][i] =
+                        ((1.0 - s.smoothing) * old[j][i] + s.smoothing * mean).clamp(s.min, s.max);
+                }
+            }
         }
     }
 }

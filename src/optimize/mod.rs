@@ -27,13 +27,15 @@
 //!   tolerance are in density units whatever `x_unit` is. A design whose density leaves
 //!   `[min printable, max packing]` anywhere on the face is not traced: it gets the penalty
 //!   `1000 + violation`.
-//! - [`feedback`]: per-strip damped ratio updates of a tabulated density.
+//! - [`feedback`]: per-strip damped ratio updates of a tabulated density (or per cell of a
+//!   density grid with `--dims 2`).
 //! - [`export`]: `dots.csv`, `dots.svg`, `dots.dxf`.
 //!
 //! After the search, the first and the final design are both re-traced with a fresh seed
 //! and more photons (`--verify-photons`), and [`OptimizeResult::write`] writes
-//! `optimized.toml`, `history.csv`, `density.png`, `profile.png`, `optimize.json`, the dot
-//! files and the two traces' outputs in `initial/` and `final/`.
+//! `optimized.toml`, `history.csv`, `density.png`, `profile.png` (and `density_map.png` for
+//! a density grid), `optimize.json`, the dot files and the two traces' outputs in
+//! `initial/` and `final/`.
 
 pub mod cli;
 pub mod export;
@@ -42,10 +44,11 @@ pub mod nelder_mead;
 pub mod objective;
 
 use crate::accel::BackendChoice;
-use crate::optics::dots::{Density, DotPattern};
+use crate::optics::dots::{Density, DensityGrid, DotPattern};
 use crate::optics::surface::{Estimator, SurfaceModel};
 use crate::output::atomic::StagedDir;
 use crate::output::plot::{Chart, Scale, Series, write_chart};
+use crate::output::png::{PreviewOptions, write_false_colour};
 use crate::run::summary::Summary;
 use crate::run::{self, ConvergenceRow, RunOptions, RunResult, StoppedBy};
 use crate::scene::Scene;
@@ -111,6 +114,10 @@ pub struct OptimizeOptions {
     pub alpha: f64,
     /// Feedback: smoothing weight of the neighbours (0: none).
     pub smoothing: f64,
+    /// Feedback: 1 (a table along the axis) or 2 (a grid over the face).
+    pub dims: usize,
+    /// Feedback in 2-D: knots of the grid along and across the axis (default 56 x 28).
+    pub cells: Option<(usize, usize)>,
     /// Profile strips along the axis (default: the detector's bins along it).
     pub strips: Option<usize>,
     /// Leave strips within this many mm of either end of the span out of the objective.
@@ -145,6 +152,8 @@ impl Default for OptimizeOptions {
             simplex_tol: 2e-3,
             alpha: 0.7,
             smoothing: 0.25,
+            dims: 1,
+            cells: None,
             strips: None,
             edge_margin_mm: 0.0,
             verify_photons: 10_000_000,
@@ -379,10 +388,23 @@ fn ser_density<S: serde::Serializer>(d: &Density, s: S) -> Result<S::Ok, S::Erro
     enum D<'a> {
         Polynomial(&'a [f64]),
         Table(&'a [[f64; 2]]),
+        Grid {
+            x_max: f64,
+            v_min: f64,
+            width: f64,
+            values: &'a [Vec<f64>],
+        },
     }
     match d {
         Density::Polynomial(c) => D::Polynomial(c).serialize(s),
         Density::Table(k) => D::Table(k).serialize(s),
+        Density::Grid(g) => D::Grid {
+            x_max: g.x_max,
+            v_min: g.v_min,
+            width: g.width,
+            values: &g.values,
+        }
+        .serialize(s),
     }
 }
 
@@ -439,6 +461,21 @@ fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
 /// How far `density` leaves `[min, max]` anywhere on the pattern's span (0: feasible;
 /// infinite for non-finite values).
 pub fn violation(pattern: &DotPattern, density: &Density, min: f64, max: f64) -> f64 {
+    if let Density::Grid(g) = density {
+        // Bilinear values lie between the knots'.
+        return g
+            .values
+            .iter()
+            .flatten()
+            .map(|&d| {
+                if d.is_finite() {
+                    (min - d).max(d - max).max(0.0)
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(0.0, f64::max);
+    }
     let samples = 2048;
     let mut p = pattern.clone();
     p.density = density.clone();
@@ -538,6 +575,22 @@ impl<'a> Search<'a> {
         scene
     }
 
+    /// The figure of merit and its standard error: for the 2-D feedback the area cv (the
+    /// non-uniformity it can fix is across the axis too) debiased by its noise floor
+    /// `sqrt(cv^2 - floor^2)` (per-bin noise dominates the raw area cv at few photons),
+    /// else the profile cv.
+    fn score(&self, ev: &Evaluation) -> (f64, f64) {
+        if self.options.method == Method::Feedback && self.options.dims == 2 {
+            let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
+                .max(0.0)
+                .sqrt();
+            let noise = ev.area_cv_noise * ev.area_cv / debiased.max(ev.area_cv_noise);
+            (debiased, noise)
+        } else {
+            (ev.objective, ev.noise)
+        }
+    }
+
     /// Trace a design with the search's seed and photons; keeps the first and the best.
     fn evaluate(&mut self, density: &Density) -> Result<Evaluation> {
         self.evaluations += 1;
@@ -555,7 +608,7 @@ impl<'a> Search<'a> {
         let better = self
             .best
             .as_ref()
-            .is_none_or(|(_, b, _)| ev.objective < b.objective);
+            .is_none_or(|(_, b, _)| self.score(&ev).0 < self.score(b).0);
         if better {
             self.best = Some((run, ev.clone(), density.clone()));
         }
@@ -597,6 +650,7 @@ pub fn optimize(
     options: &OptimizeOptions,
     progress: &mut dyn FnMut(&IterationReport),
 ) -> Result<OptimizeResult> {
+    check_method_options(options)?;
     let mut search = Search::new(scene, options)?;
     let initial_density = search.pattern.density.clone();
     let termination = match options.method {
@@ -708,7 +762,7 @@ fn run_nelder_mead(
 ) -> Result<String> {
     let scene_degree = match &search.pattern.density {
         Density::Polynomial(c) => c.len().saturating_sub(1),
-        Density::Table(_) => 0,
+        Density::Table(_) | Density::Grid(_) => 0,
     };
     let degree = search.options.degree.unwrap_or(scene_degree.max(3));
     let c0 = start_coefficients(search, degree);
@@ -774,12 +828,174 @@ fn run_nelder_mead(
 }
 
 fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport)) -> Result<String> {
+    let settings = feedback_settings(search)?;
     let p = search.pattern.clone();
-    let knots = feedback::knot_positions(&p, feedback::knot_count(&p, search.strips));
-    let mut d: Vec<f64> = knots
-        .iter()
-        .map(|&x| p.density.eval(x).clamp(search.min, search.max))
-        .collect();
+    match search.options.dims {
+        1 => {
+            let knots = feedback::knot_positions(&p, feedback::knot_count(&p, search.strips));
+            let d = knots
+                .iter()
+                .map(|&x| p.density.eval(x).clamp(search.min, search.max))
+                .collect();
+            let mut table = TableFeedback {
+                pattern: p,
+                knots,
+                d,
+                settings,
+            };
+            feedback_rounds(search, &mut table, "feedback", "objective", progress)
+        }
+        2 => {
+            let cells = search.options.cells.unwrap_or((56, 28));
+            if cells.0 < 2 || cells.1 < 2 {
+                bail!(
+                    "--cells needs at least 2 knots each way, got {},{}",
+                    cells.0,
+                    cells.1
+                );
+            }
+            let (v_lo, v_hi) = match &p.density {
+                Density::Grid(g) => (g.v_min, g.v_min + g.width),
+                _ => face_v_range(search),
+            };
+            let grid = feedback::initial_grid(&p, v_lo, v_hi - v_lo, cells, search.min, search.max);
+            let mut grid = GridFeedback {
+                pattern: p,
+                grid,
+                settings,
+            };
+            feedback_rounds(search, &mut grid, "feedback-2d", "area cv", progress)
+        }
+        d => bail!("--dims must be 1 or 2, got {d}"),
+    }
+}
+
+/// What a feedback search tunes: a table along the axis or a grid over the face.
+trait FeedbackDesign {
+    /// The design to trace next.
+    fn density(&self) -> Density;
+    /// Its parameters, for the history.
+    fn params(&self) -> Vec<f64>;
+    /// One damped-ratio update from a trace of the current design.
+    fn update(&mut self, scene: &Scene, ev: &Evaluation);
+}
+
+/// 1-D feedback: one knot per strip along the axis.
+struct TableFeedback {
+    pattern: DotPattern,
+    knots: Vec<f64>,
+    d: Vec<f64>,
+    settings: feedback::Settings,
+}
+
+impl FeedbackDesign for TableFeedback {
+    fn density(&self) -> Density {
+        Density::Table(
+            self.knots
+                .iter()
+                .zip(&self.d)
+                .map(|(x, d)| [*x, *d])
+                .collect(),
+        )
+    }
+    fn params(&self) -> Vec<f64> {
+        self.d.clone()
+    }
+    fn update(&mut self, _scene: &Scene, ev: &Evaluation) {
+        feedback::update(
+            &self.pattern,
+            &self.knots,
+            &mut self.d,
+            &ev.profile,
+            &self.settings,
+        );
+    }
+}
+
+/// 2-D feedback: a grid of knots over the face.
+struct GridFeedback {
+    pattern: DotPattern,
+    grid: DensityGrid,
+    settings: feedback::Settings,
+}
+
+impl FeedbackDesign for GridFeedback {
+    fn density(&self) -> Density {
+        Density::Grid(self.grid.clone())
+    }
+    fn params(&self) -> Vec<f64> {
+        self.grid.values.iter().flatten().copied().collect()
+    }
+    fn update(&mut self, scene: &Scene, ev: &Evaluation) {
+        let measured = feedback::measured_per_cell(scene, &self.pattern, &self.grid, &ev.map);
+        feedback::update_grid(&mut self.grid, &measured, &self.settings);
+    }
+}
+
+/// The feedback rounds: round 0 traces the scene's own density, every later round the
+/// design updated from the round before; stops at the objective bound, the round cap or
+/// after [`feedback::STALL_ROUNDS`] rounds without a gain beyond the score's noise.
+fn feedback_rounds(
+    search: &mut Search,
+    design: &mut dyn FeedbackDesign,
+    step: &str,
+    score_name: &str,
+    progress: &mut dyn FnMut(&IterationReport),
+) -> Result<String> {
+    let mut iteration = 0;
+    let mut stalled = 0;
+    loop {
+        let density = if iteration == 0 {
+            search.pattern.density.clone()
+        } else {
+            design.density()
+        };
+        let before = search.best.as_ref().map(|(_, b, _)| search.score(b));
+        let ev = search.evaluate(&density)?;
+        let (score, _) = search.score(&ev);
+        match before {
+            Some((b, noise)) if score > b - noise => stalled += 1,
+            _ => stalled = 0,
+        }
+        let best = search
+            .best
+            .as_ref()
+            .map_or(ev.clone(), |(_, b, _)| b.clone());
+        let step = if iteration == 0 { "initial" } else { step };
+        search.report(iteration, step.into(), design.params(), &best, progress);
+        if search.options.target_cv.is_some_and(|t| score <= t) {
+            return Ok(format!("objective bound reached after {iteration} rounds"));
+        }
+        if stalled >= feedback::STALL_ROUNDS {
+            return Ok(format!(
+                "no gain beyond the {score_name}'s noise in {stalled} rounds, after {iteration} rounds"
+            ));
+        }
+        if iteration >= search.options.max_iter {
+            return Ok(format!("iteration cap reached after {iteration} rounds"));
+        }
+        design.update(search.scene, &ev);
+        iteration += 1;
+    }
+}
+
+/// Options that only one method takes must not be given to the other.
+fn check_method_options(options: &OptimizeOptions) -> Result<()> {
+    if !(1..=2).contains(&options.dims) {
+        bail!("--dims must be 1 or 2, got {}", options.dims);
+    }
+    let grid = options.method == Method::Feedback && options.dims == 2;
+    if options.dims == 2 && !grid {
+        bail!("--dims 2 needs --method feedback (Nelder-Mead tunes a polynomial along the axis)");
+    }
+    if options.cells.is_some() && !grid {
+        bail!("--cells needs --method feedback --dims 2");
+    }
+    Ok(())
+}
+
+/// The feedback settings of `search`'s options, checked.
+fn feedback_settings(search: &Search) -> Result<feedback::Settings> {
     let settings = feedback::Settings {
         alpha: search.options.alpha,
         smoothing: search.options.smoothing,
@@ -795,45 +1011,27 @@ fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport))
             settings.smoothing
         );
     }
-    let table = |d: &[f64]| Density::Table(knots.iter().zip(d).map(|(x, d)| [*x, *d]).collect());
-    let mut iteration = 0;
-    let mut stalled = 0;
-    loop {
-        // Round 0 traces the scene's own density; later rounds the table.
-        let density = if iteration == 0 {
-            p.density.clone()
-        } else {
-            table(&d)
-        };
-        let before = search.best.as_ref().map(|(_, b, _)| (b.objective, b.noise));
-        let ev = search.evaluate(&density)?;
-        match before {
-            Some((b, noise)) if ev.objective > b - noise => stalled += 1,
-            _ => stalled = 0,
+    Ok(settings)
+}
+
+/// The extent of the optimized face across the pattern's axis (mm along `across`).
+fn face_v_range(search: &Search) -> (f64, f64) {
+    let mesh = &search.scene.mesh;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for prim in 0..mesh.len() as u32 {
+        if mesh.tri_tag[prim as usize] as usize != search.tag_id {
+            continue;
         }
-        let best = search
-            .best
-            .as_ref()
-            .map_or(ev.clone(), |(_, b, _)| b.clone());
-        let step = if iteration == 0 {
-            "initial"
-        } else {
-            "feedback"
-        };
-        search.report(iteration, step.into(), d.clone(), &best, progress);
-        if search.options.target_cv.is_some_and(|t| ev.objective <= t) {
-            return Ok(format!("objective bound reached after {iteration} rounds"));
+        for c in mesh.corners(prim) {
+            let v = search.pattern.face_coords(c).y;
+            lo = lo.min(v);
+            hi = hi.max(v);
         }
-        if stalled >= feedback::STALL_ROUNDS {
-            return Ok(format!(
-                "no gain beyond the objective's noise in {stalled} rounds, after {iteration} rounds"
-            ));
-        }
-        if iteration >= search.options.max_iter {
-            return Ok(format!("iteration cap reached after {iteration} rounds"));
-        }
-        feedback::update(&p, &knots, &mut d, &ev.profile, &settings);
-        iteration += 1;
+    }
+    if lo.is_finite() && hi > lo {
+        (lo, hi)
+    } else {
+        (0.0, 1.0)
     }
 }
 
@@ -878,6 +1076,7 @@ impl OptimizeResult {
             .with_context(|| format!("{}: no [surfaces.{}]", path.display(), self.tag))?;
         surface.remove("density");
         surface.remove("density_table");
+        surface.remove("density_grid");
         match &self.final_density {
             Density::Polynomial(c) => {
                 let c = c.iter().map(|&v| toml::Value::Float(v)).collect();
@@ -891,6 +1090,18 @@ impl OptimizeResult {
                     })
                     .collect();
                 surface.insert("density_table".into(), toml::Value::Array(knots));
+            }
+            Density::Grid(g) => {
+                let mut t = toml::Table::new();
+                t.insert("width_mm".into(), toml::Value::Float(g.width));
+                t.insert("v_min_mm".into(), toml::Value::Float(g.v_min));
+                let rows = g
+                    .values
+                    .iter()
+                    .map(|r| toml::Value::Array(r.iter().map(|&v| toml::Value::Float(v)).collect()))
+                    .collect();
+                t.insert("values".into(), toml::Value::Array(rows));
+                surface.insert("density_grid".into(), toml::Value::Table(t));
             }
         }
         let name = doc
@@ -930,6 +1141,14 @@ impl OptimizeResult {
             Density::Table(k) => k.iter().for_each(|[x, _]| {
                 let _ = write!(s, ",d@{x:.5}");
             }),
+            Density::Grid(g) => {
+                let (nx, ny) = g.shape();
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let _ = write!(s, ",d{i}_{j}");
+                    }
+                }
+            }
         }
         s.push('\n');
         for r in &self.history {
@@ -970,8 +1189,12 @@ impl OptimizeResult {
                 })
                 .collect()
         };
+        let across = match self.final_density {
+            Density::Grid(_) => ", mean across the axis",
+            _ => "",
+        };
         Chart {
-            title: format!("Dot density d(x) on {} ({})", self.tag, self.method),
+            title: format!("Dot density d(x) on {} ({}{across})", self.tag, self.method),
             x_label: "position along the propagation axis (mm)".into(),
             y_label: "dot density d (area fraction)".into(),
             x_scale: Scale::Linear,
@@ -1038,6 +1261,9 @@ impl OptimizeResult {
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         write_chart(&staged.stage_path("density.png"), &self.density_chart())?;
         write_chart(&staged.stage_path("profile.png"), &self.profile_chart())?;
+        if let Density::Grid(g) = &self.final_density {
+            write_density_map(&staged.stage_path("density_map.png"), g)?;
+        }
         staged.write_bytes("dots.csv", export::to_csv(&self.dots).as_bytes())?;
         staged.write_bytes("dots.svg", export::to_svg(&self.dots).as_bytes())?;
         staged.write_bytes("dots.dxf", export::to_dxf(&self.dots).as_bytes())?;
@@ -1071,6 +1297,18 @@ impl OptimizeResult {
         files.extend(written);
         Ok(files)
     }
+}
+
+/// False-colour map of a 2-D density grid's knots: columns along the axis (left to right
+/// from the lamps), rows across it (the first row at the bottom).
+fn write_density_map(path: &Path, g: &DensityGrid) -> Result<()> {
+    let (nx, ny) = g.shape();
+    let values: Vec<f64> = g.values.iter().flatten().copied().collect();
+    let opts = PreviewOptions {
+        min: Some(0.0),
+        max: None,
+    };
+    write_false_colour(path, nx, ny, &values, &opts)
 }
 
 /// Folders removed when dropped (the staging folders of `initial/` and `final/`).

@@ -175,6 +175,9 @@ pub struct Evaluation {
     pub photons: u64,
     /// Tracing time (s).
     pub seconds: f64,
+    /// The traced flux map (for the 2-D feedback).
+    #[serde(skip)]
+    pub map: Map,
 }
 
 impl Evaluation {
@@ -212,6 +215,7 @@ impl Evaluation {
             area_noise_floor,
             photons,
             seconds,
+            map: map.clone(),
         }
     }
 }

@@ -143,6 +143,9 @@ pub enum SurfaceSpec {
         /// Tabulated density: knots `[x, d]`, x increasing, linear between (or `density`).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         density_table: Option<Vec<[f64; 2]>>,
+        /// Density on a grid of knots over the face, bilinear (or `density`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        density_grid: Option<DensityGridSpec>,
         /// Unit of the polynomial variable.
         #[serde(default)]
         x_unit: XUnit,
@@ -221,6 +224,20 @@ pub enum SurfaceSpec {
     },
     /// Black absorber.
     Absorber {},
+}
+
+/// `density_grid = { width_mm = W, values = [[...], ...] }` of a dots surface: rows across
+/// the axis (`v_min_mm ..= v_min_mm + width_mm`), columns along it (`x` over `0..=x_max`).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DensityGridSpec {
+    /// Span across the axis from the first to the last row (mm).
+    pub width_mm: f64,
+    /// Position of the first row across the axis (mm from the origin along `across`).
+    #[serde(default)]
+    pub v_min_mm: f64,
+    /// `values[j][i]`: row `j` across the axis, column `i` along it.
+    pub values: Vec<Vec<f64>>,
 }
 
 /// A light source.

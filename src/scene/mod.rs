@@ -16,7 +16,7 @@ mod solids;
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};
-use crate::optics::dots::{Density, DotPattern};
+use crate::optics::dots::{Density, DensityGrid, DotPattern};
 use crate::optics::surface::{Interface, Medium, MediumId, Phong, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::sources::intensity::IntensityProfile;
@@ -540,22 +540,42 @@ fn build_surface(
             length_mm,
             density,
             density_table,
+            density_grid,
             x_unit,
             mirror,
         } => {
-            let (density, field) = match (density, density_table) {
-                (Some(c), None) => (Density::Polynomial(c.clone()), f("density")),
-                (None, Some(k)) => (Density::Table(k.clone()), f("density_table")),
-                (Some(_), Some(_)) => {
+            let (density, field) = match (density, density_table, density_grid) {
+                (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
+                (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
+                (None, None, Some(g)) => {
+                    let x_max = crate::optics::gradation::graded_x(
+                        if *mirror {
+                            0.5 * *length_mm
+                        } else {
+                            *length_mm
+                        },
+                        *length_mm,
+                        *x_unit,
+                        *mirror,
+                    );
+                    let grid = DensityGrid {
+                        x_max,
+                        v_min: g.v_min_mm,
+                        width: g.width_mm,
+                        values: g.values.clone(),
+                    };
+                    (Density::Grid(grid), f("density_grid"))
+                }
+                (Some(_), Some(_), _) | (Some(_), _, Some(_)) | (_, Some(_), Some(_)) => {
                     return Err(ctx.err(
                         &f("density"),
-                        "give either density (polynomial) or density_table, not both",
+                        "give only one of density (polynomial), density_table and density_grid",
                     ));
                 }
-                (None, None) => {
+                (None, None, None) => {
                     return Err(ctx.err(
                         &f("density"),
-                        "missing: give density (polynomial coefficients) or density_table ([x, d] knots)",
+                        "missing: give density (polynomial coefficients), density_table ([x, d] knots) or density_grid",
                     ));
                 }
             };

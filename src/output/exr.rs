@@ -3,7 +3,8 @@
 //! [`write_channels`] stores any number of equally sized `f32` grids as the channels of a
 //! single-layer, scan-line EXR file with lossless ZIP compression (16-line blocks), plus
 //! numeric header attributes (e.g. `bin_size_x_mm`) stored as EXR `double` attributes.
-//! [`read_channels`] reads such a file back exactly.
+//! [`read_channels`] reads such a file back exactly. The header attributes are stored
+//! in name order, so the same image always gives the same bytes.
 //!
 //! Orientation: grids are row-major, `x` fastest, grid row 0 is the lowest `y`. EXR (like
 //! every image format) stores its top row first, with image `y` pointing down, so the rows
@@ -34,7 +35,7 @@ pub type ChannelImage = (usize, usize, Vec<(String, Vec<f32>)>, Vec<(String, f64
 /// same rules and must not be a standard EXR attribute name (such as `channels`, `owner`,
 /// `dataWindow`); values are stored as EXR `double`. Compression is lossless ZIP.
 ///
-/// The file is written directly to `path`; use
+/// The same arguments always give the same bytes. The file is written directly to `path`; use
 /// [`StagedDir`](crate::output::atomic::StagedDir) for all-or-nothing output.
 pub fn write_channels(
     path: &Path,
@@ -47,11 +48,53 @@ pub fn write_channels(
     let image = build_image(width, height, channels, attributes).with_context(what)?;
     // Compress on this thread: parallel compression stores blocks in completion order,
     // so the same image would give different bytes from run to run.
+    let mut bytes = std::io::Cursor::new(Vec::new());
     image
         .write()
         .non_parallel()
-        .to_file(path)
-        .with_context(what)
+        .to_buffered(&mut bytes)
+        .with_context(what)?;
+    let mut bytes = bytes.into_inner();
+    sort_header_attributes(&mut bytes).with_context(what)?;
+    std::fs::write(path, bytes).with_context(what)
+}
+
+/// Put the header attributes of a single-part EXR file in name order, in place.
+///
+/// The exr crate writes the attributes it keeps in a hash map in that map's order, which
+/// changes from run to run; sorted, the same image always gives the same bytes. The header
+/// keeps its length, so the offset table after it stays valid.
+fn sort_header_attributes(bytes: &mut [u8]) -> Result<()> {
+    const HEADER_START: usize = 8; // magic number and version field
+    let mut attributes: Vec<&[u8]> = Vec::new();
+    let mut i = HEADER_START;
+    while *bytes.get(i).context("header has no end")? != 0 {
+        let start = i;
+        let name_end = nul_after(bytes, i)?;
+        let type_end = nul_after(bytes, name_end + 1)?;
+        let size_bytes = bytes
+            .get(type_end + 1..type_end + 5)
+            .context("header attribute size is cut off")?;
+        let size = u32::from_le_bytes(size_bytes.try_into()?) as usize;
+        i = type_end + 5 + size;
+        ensure!(i <= bytes.len(), "header attribute value is cut off");
+        attributes.push(&bytes[start..i]);
+    }
+    let name = |a: &&[u8]| a.split(|&b| b == 0).next().unwrap_or_default().to_vec();
+    attributes.sort_by_key(name);
+    let sorted: Vec<u8> = attributes.concat();
+    bytes[HEADER_START..i].copy_from_slice(&sorted);
+    Ok(())
+}
+
+/// Index of the first NUL byte at or after `from`.
+fn nul_after(bytes: &[u8], from: usize) -> Result<usize> {
+    let rest = bytes.get(from..).context("header is cut off")?;
+    let at = rest
+        .iter()
+        .position(|&b| b == 0)
+        .context("header text has no end")?;
+    Ok(from + at)
 }
 
 /// Validate the arguments of [`write_channels`] and assemble the EXR image.
@@ -201,6 +244,34 @@ mod tests {
         fn drop(&mut self) {
             let _ = std::fs::remove_file(&self.0);
         }
+    }
+
+    #[test]
+    fn same_image_gives_same_bytes() {
+        // Each write builds a new hash map of attributes, with its own random order.
+        let attributes: Vec<(String, f64)> = (0..12)
+            .map(|k| (format!("attr_{k:02}"), k as f64))
+            .collect();
+        let attributes: Vec<(&str, f64)> =
+            attributes.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let data: Vec<f32> = (0..6).map(|i| i as f32).collect();
+        let files: Vec<Vec<u8>> = (0..6)
+            .map(|_| {
+                let file = TempFile::new("same-bytes");
+                write_channels(&file.0, 3, 2, &[("flux", &data)], &attributes).unwrap();
+                std::fs::read(&file.0).unwrap()
+            })
+            .collect();
+        assert!(files.windows(2).all(|w| w[0] == w[1]));
+        let file = TempFile::new("same-bytes-read");
+        std::fs::write(&file.0, &files[0]).unwrap();
+        let (_, _, channels, read) = read_channels(&file.0).unwrap();
+        assert_eq!(channels[0].1, data);
+        let expected: Vec<(String, f64)> = attributes
+            .iter()
+            .map(|(n, v)| (n.to_string(), *v))
+            .collect();
+        assert_eq!(read, expected);
     }
 
     #[test]

@@ -2,11 +2,13 @@
 //! run (never a pass/fail timing).
 //!
 //! ```text
-//! blutrace bench [--photons N] [--threads T]
+//! blutrace bench [--photons N] [--threads T] [--repeat R]
 //! ```
 //!
 //! Scenes: `scenes/notebook14` as bundled, and the same scene with its lamp reflectors
-//! split into about 200k triangles (same surfaces, so the same physics). For each backend
+//! split into about 540k triangles (same surfaces, so the same physics). Every timing is
+//! the median of `R` (default 3) rounds, each round measuring every configuration once in
+//! turn, so a passing load on the machine does not favour one of them. For each backend
 //! (with and without the convex-solid fast path) it traces the same photons and reports
 //! rates and the ratio to obvhs. A second table times nearest-hit queries of rays inside
 //! the light guide alone: the convex path against each backend. A third table gives the
@@ -52,54 +54,89 @@ fn backends() -> Vec<BackendChoice> {
     b
 }
 
-/// Trace `photons` through each backend on both scenes.
+/// Trace `photons` through each backend on both scenes, `repeat` rounds (medians).
 pub fn trace_table(
     scene_dir: &Path,
     photons: u64,
     threads: Option<usize>,
+    repeat: usize,
 ) -> Result<Vec<BenchRow>> {
     let base = Scene::load(&scene_dir.join("scene.toml"))?;
     let mut large = base.clone();
     large.subdivide_tag("lamp_reflector", 5)?;
-    let mut rows = Vec::new();
-    for (label, scene) in [
+    let scenes = [
         ("notebook14", &base),
         ("notebook14, reflectors split to 540k triangles", &large),
-    ] {
-        let mut reference = f64::NAN;
+    ];
+    let mut configs = Vec::new();
+    for (label, scene) in scenes {
         for backend in backends() {
             for convex in [false, true] {
-                let o = RunOptions {
-                    photons,
-                    seed: 1,
-                    threads,
-                    backend,
-                    convex,
-                    ..RunOptions::default()
-                };
-                let r = run::trace(scene, &o, &|_| {})?;
-                let s = r.summary();
-                if backend == BackendChoice::Bvh && !convex {
-                    reference = s.photons_per_s;
-                }
-                rows.push(BenchRow {
-                    scene: label.into(),
-                    triangles: scene.mesh.len(),
-                    backend: r.backend.into(),
-                    convex,
-                    photons_per_s: s.photons_per_s,
-                    interactions_per_s: s.interactions_per_s,
-                    ratio_to_obvhs: s.photons_per_s / reference,
-                });
+                configs.push((label, scene, backend, convex));
             }
         }
+    }
+    // rates[c]: (photons/s, interactions/s, backend name) of config c, one per round.
+    let mut rates: Vec<Vec<(f64, f64)>> = vec![Vec::new(); configs.len()];
+    let mut names = vec![""; configs.len()];
+    for _ in 0..repeat.max(1) {
+        for (c, &(_, scene, backend, convex)) in configs.iter().enumerate() {
+            let o = RunOptions {
+                photons,
+                seed: 1,
+                threads,
+                backend,
+                convex,
+                ..RunOptions::default()
+            };
+            let r = run::trace(scene, &o, &|_| {})?;
+            let s = r.summary();
+            rates[c].push((s.photons_per_s, s.interactions_per_s));
+            names[c] = r.backend;
+        }
+    }
+    let mut rows: Vec<BenchRow> = Vec::new();
+    for (c, &(label, scene, backend, convex)) in configs.iter().enumerate() {
+        let photons_per_s = median(rates[c].iter().map(|r| r.0).collect());
+        let interactions_per_s = median(rates[c].iter().map(|r| r.1).collect());
+        let reference = if backend == BackendChoice::Bvh && !convex {
+            photons_per_s
+        } else {
+            rows.iter()
+                .rev()
+                .find(|r| r.scene == label && r.backend == "bvh" && !r.convex)
+                .map_or(f64::NAN, |r| r.photons_per_s)
+        };
+        rows.push(BenchRow {
+            scene: label.into(),
+            triangles: scene.mesh.len(),
+            backend: names[c].into(),
+            convex,
+            photons_per_s,
+            interactions_per_s,
+            ratio_to_obvhs: photons_per_s / reference,
+        });
     }
     Ok(rows)
 }
 
+/// The median of `values` (NaN when empty).
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    match values.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => values[n / 2],
+        n => 0.5 * (values[n / 2 - 1] + values[n / 2]),
+    }
+}
+
 /// Nearest-hit queries per second for rays inside the guide: each backend, and the convex
-/// path. Returns (name, queries/s) with the convex path last.
-pub fn in_guide_table(scene_dir: &Path, queries: usize) -> Result<Vec<(String, f64)>> {
+/// path, `repeat` rounds (medians). Returns (name, queries/s) with the convex path last.
+pub fn in_guide_table(
+    scene_dir: &Path,
+    queries: usize,
+    repeat: usize,
+) -> Result<Vec<(String, f64)>> {
     let scene = Scene::load(&scene_dir.join("scene.toml"))?;
     let medium = (0..scene.media.len() as u16).find(|&m| scene.convex_solid(m).is_some());
     let Some(solid) = medium.and_then(|m| scene.convex_solid(m)) else {
@@ -126,21 +163,26 @@ pub fn in_guide_table(scene_dir: &Path, queries: usize) -> Result<Vec<(String, f
             ));
         }
     }
-    let mut out = Vec::new();
-    for backend in backends() {
-        let accel: Box<dyn Accel> = accel::build(backend, scene.mesh.clone())?;
-        out.push((
-            accel.name().to_string(),
-            rate(&rays, |r| {
+    let accels: Vec<Box<dyn Accel>> = backends()
+        .into_iter()
+        .map(|b| accel::build(b, scene.mesh.clone()))
+        .collect::<Result<_>>()?;
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); accels.len() + 1];
+    for _ in 0..repeat.max(1) {
+        for (a, accel) in accels.iter().enumerate() {
+            times[a].push(rate(&rays, |r| {
                 accel.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
-            }),
-        ));
+            }));
+        }
+        times[accels.len()].push(rate(&rays, |r| {
+            solid.exit(&scene.mesh, r).map_or(0, |h| h.prim)
+        }));
     }
-    out.push((
-        "convex".into(),
-        rate(&rays, |r| solid.exit(&scene.mesh, r).map_or(0, |h| h.prim)),
-    ));
-    Ok(out)
+    let names = accels
+        .iter()
+        .map(|a| a.name().to_string())
+        .chain(["convex".to_string()]);
+    Ok(names.zip(times).map(|(n, t)| (n, median(t))).collect())
 }
 
 /// One row of the error-against-time table.
@@ -207,4 +249,37 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> u32) -> f64 {
     let checksum: u64 = rays.iter().map(|r| u64::from(f(r))).sum();
     std::hint::black_box(checksum);
     rays.len() as f64 / start.elapsed().as_secs_f64()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(Vec::new()).is_nan());
+    }
+
+    #[test]
+    fn tables_have_every_configuration_and_obvhs_as_reference() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/notebook14");
+        let rows = trace_table(&dir, 4096, Some(1), 2).unwrap();
+        let per_scene = 2 * backends().len();
+        assert_eq!(rows.len(), 2 * per_scene);
+        for scene in rows.chunks(per_scene) {
+            assert_eq!((scene[0].backend.as_str(), scene[0].convex), ("bvh", false));
+            assert_eq!(scene[0].ratio_to_obvhs, 1.0);
+            for r in scene {
+                assert!(r.photons_per_s > 0.0 && r.interactions_per_s > r.photons_per_s);
+                let expected = r.photons_per_s / scene[0].photons_per_s;
+                assert_eq!(r.ratio_to_obvhs, expected);
+            }
+        }
+        let queries = in_guide_table(&dir, 1000, 2).unwrap();
+        assert_eq!(queries.len(), backends().len() + 1);
+        assert_eq!(queries.last().unwrap().0, "convex");
+        assert!(queries.iter().all(|(_, q)| *q > 0.0));
+    }
 }

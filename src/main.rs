@@ -39,6 +39,9 @@ enum Command {
         /// The notebook scene folder.
         #[arg(long, default_value = "scenes/notebook14")]
         scene: PathBuf,
+        /// Rounds per timing (each round measures every configuration once; medians).
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
     },
     /// Validate a scene and print what it uses.
     Check {
@@ -127,7 +130,8 @@ impl Command {
                 photons,
                 threads,
                 scene,
-            } => bench(&scene, photons, threads),
+                repeat,
+            } => bench(&scene, photons, threads, repeat),
             Command::Check { scene } => check(&scene_path(&scene)),
         }
     }
@@ -285,12 +289,12 @@ fn merge(args: MergeArgs) -> Result<()> {
     Ok(())
 }
 
-fn bench(scene: &Path, photons: u64, threads: Option<usize>) -> Result<()> {
+fn bench(scene: &Path, photons: u64, threads: Option<usize>, repeat: usize) -> Result<()> {
     println!(
         "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
     );
     println!("|---|---:|---|---|---:|---:|---:|");
-    for r in blutrace::bench::trace_table(scene, photons, threads)? {
+    for r in blutrace::bench::trace_table(scene, photons, threads, repeat)? {
         println!(
             "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
             r.scene,
@@ -303,7 +307,7 @@ fn bench(scene: &Path, photons: u64, threads: Option<usize>) -> Result<()> {
         );
     }
     println!();
-    let table = blutrace::bench::in_guide_table(scene, 1_000_000)?;
+    let table = blutrace::bench::in_guide_table(scene, 1_000_000, repeat)?;
     let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
     println!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
     println!("|---|---:|---:|");

@@ -167,12 +167,25 @@ impl Mesh {
     /// nudged ray went past an edge the true path does not), the nudged ray's point is
     /// kept: a point off the triangle could lie outside a closed solid and leak.
     pub fn refine_hit_from(&self, pos: DVec3, ray: &Ray, prim: u32, t_backend: f64) -> SurfaceHit {
+        self.refine_hit_from_on(pos, ray, prim, t_backend, self.normal(prim))
+    }
+
+    /// [`Mesh::refine_hit_from`] with the triangle's unit normal given (from
+    /// [`Mesh::unit_normals`]).
+    pub fn refine_hit_from_on(
+        &self,
+        pos: DVec3,
+        ray: &Ray,
+        prim: u32,
+        t_backend: f64,
+        normal: DVec3,
+    ) -> SurfaceHit {
         let lead = (ray.origin - pos).length();
-        let exact = self.refine_hit(&Ray::new(pos, ray.dir), prim, t_backend + lead);
+        let exact = self.refine_hit_on(&Ray::new(pos, ray.dir), prim, t_backend + lead, normal);
         if exact.t > lead && self.contains(prim, exact.point) {
             return exact;
         }
-        let nudged = self.refine_hit(ray, prim, t_backend);
+        let nudged = self.refine_hit_on(ray, prim, t_backend, normal);
         SurfaceHit {
             t: (nudged.point - pos).length(),
             ..nudged
@@ -187,8 +200,13 @@ impl Mesh {
     /// Turn a backend's (distance, primitive) into a full hit, recomputing the distance
     /// in f64 against the triangle's plane so every backend yields the same point.
     pub fn refine_hit(&self, ray: &Ray, prim: u32, t_backend: f64) -> SurfaceHit {
-        let [a, _, _] = self.corners(prim);
-        let normal = self.normal(prim);
+        self.refine_hit_on(ray, prim, t_backend, self.normal(prim))
+    }
+
+    /// [`Mesh::refine_hit`] with the triangle's unit normal given (from
+    /// [`Mesh::unit_normals`]).
+    pub fn refine_hit_on(&self, ray: &Ray, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
+        let a = self.positions[self.triangles[prim as usize][0] as usize];
         let denom = normal.dot(ray.dir);
         let t_plane = if denom.abs() > 1e-300 {
             normal.dot(a - ray.origin) / denom
@@ -206,6 +224,12 @@ impl Mesh {
             point: ray.at(t),
             normal,
         }
+    }
+
+    /// The unit normal of every triangle ([`Mesh::normal`]), for a run to look up
+    /// instead of recomputing at every hit.
+    pub fn unit_normals(&self) -> Vec<DVec3> {
+        (0..self.len() as u32).map(|p| self.normal(p)).collect()
     }
 }
 

@@ -217,6 +217,9 @@ pub struct Tracer<'a> {
     pub estimator: Estimator,
     /// Use the convex-solid fast path inside convex media.
     pub convex: bool,
+    /// The unit normal of every triangle of the scene's mesh
+    /// ([`crate::geometry::Mesh::unit_normals`]).
+    pub normals: &'a [DVec3],
 }
 
 /// A photon in flight.
@@ -255,13 +258,14 @@ impl Tracer<'_> {
             // accumulate over thousands of bounces in a thin guide.
             let true_ray = Ray::new(p.pos, p.ray.dir);
             let surf = match scene.convex_solid(p.medium).filter(|_| self.convex) {
-                Some(solid) => solid
-                    .exit(&scene.mesh, &true_ray)
-                    .map(|h| scene.mesh.refine_hit(&true_ray, h.prim, h.t)),
-                None => self
-                    .accel
-                    .intersect(&p.ray, f64::INFINITY)
-                    .map(|h| scene.mesh.refine_hit_from(p.pos, &p.ray, h.prim, h.t)),
+                Some(solid) => solid.exit(&scene.mesh, &true_ray).map(|h| {
+                    let n = self.normals[h.prim as usize];
+                    scene.mesh.refine_hit_on(&true_ray, h.prim, h.t, n)
+                }),
+                None => self.accel.intersect(&p.ray, f64::INFINITY).map(|h| {
+                    let n = self.normals[h.prim as usize];
+                    scene.mesh.refine_hit_from_on(p.pos, &p.ray, h.prim, h.t, n)
+                }),
             };
             let t_surface = surf.map_or(f64::INFINITY, |h| h.t);
             let detected = scene.detector.intersect(&true_ray, t_surface);

@@ -222,8 +222,10 @@ pub fn trace<'a>(
         .context("cannot start worker threads")?;
     let accel: Box<dyn Accel> =
         pool.install(|| accel::build(options.backend, scene.mesh.clone()))?;
+    let normals = scene.mesh.unit_normals();
     let tracer = Tracer {
         scene,
+        normals: &normals,
         accel: accel.as_ref(),
         estimator: options.estimator,
         convex: options.convex,

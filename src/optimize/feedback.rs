@@ -163,7 +163,8 @@ pub fn initial_grid(
 }
 
 /// Mean flux of the map's bins (of `scene`'s detector) nearest to each knot of `grid`
-/// (`[row][column]`; NaN where no bin falls). Bins outside the pattern's span are left out.
+/// (`[row][column]`); knots no bin is nearest to get their neighbours' mean
+/// ([`fill_empty_cells`]). Bins outside the pattern's span are left out.
 pub fn measured_per_cell(
     scene: &Scene,
     pattern: &DotPattern,
@@ -190,7 +191,8 @@ pub fn measured_per_cell(
             count[j][i] += 1;
         }
     }
-    sum.iter()
+    let mut measured: Vec<Vec<f64>> = sum
+        .iter()
         .zip(&count)
         .map(|(s, c)| {
             s.iter()
@@ -198,7 +200,40 @@ pub fn measured_per_cell(
                 .map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN })
                 .collect()
         })
-        .collect()
+        .collect();
+    fill_empty_cells(&mut measured);
+    measured
+}
+
+/// Give every empty (NaN) cell the mean of its measured neighbours (3 x 3), repeated
+/// until every cell has a value: a grid finer than the map leaves knots that no bin is
+/// nearest to, and a knot left alone while its neighbours move would print a stripe.
+/// A grid with no measured cell at all is left as it is.
+pub fn fill_empty_cells(values: &mut [Vec<f64>]) {
+    loop {
+        let old = values.to_vec();
+        let mut filled = false;
+        let mut empty = false;
+        for (j, row) in values.iter_mut().enumerate() {
+            for (i, v) in row.iter_mut().enumerate().filter(|(_, v)| v.is_nan()) {
+                let neighbours: Vec<f64> = old[j.saturating_sub(1)..(j + 2).min(old.len())]
+                    .iter()
+                    .flat_map(|r| &r[i.saturating_sub(1)..(i + 2).min(r.len())])
+                    .copied()
+                    .filter(|m| m.is_finite())
+                    .collect();
+                if neighbours.is_empty() {
+                    empty = true;
+                } else {
+                    *v = neighbours.iter().sum::<f64>() / neighbours.len() as f64;
+                    filled = true;
+                }
+            }
+        }
+        if !(empty && filled) {
+            return;
+        }
+    }
 }
 
 /// One 2-D feedback update of the grid's knots from the flux per knot cell: every knot
@@ -257,5 +292,51 @@ pub fn update_grid(grid: &mut DensityGrid, measured: &[Vec<f64>], s: &Settings) 
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_cells_take_their_neighbours_mean() {
+        let nan = f64::NAN;
+        let mut v = vec![
+            vec![1.0, nan, 3.0, nan],
+            vec![nan, nan, nan, nan],
+            vec![nan, nan, nan, 5.0],
+        ];
+        fill_empty_cells(&mut v);
+        assert!(v.iter().flatten().all(|x| x.is_finite()), "{v:?}");
+        assert_eq!(v[0][1], 2.0);
+        assert_eq!(v[1][0], 1.0);
+        assert_eq!(v[1][3], (3.0 + 5.0) / 2.0);
+        let mut none = vec![vec![nan; 3]; 2];
+        fill_empty_cells(&mut none);
+        assert!(none.iter().flatten().all(|x| x.is_nan()));
+    }
+
+    #[test]
+    fn grid_update_moves_knots_toward_the_median_within_bounds() {
+        let mut grid = DensityGrid {
+            x_max: 1.0,
+            v_min: 0.0,
+            width: 1.0,
+            values: vec![vec![0.2, 0.2, 0.2], vec![0.2, 0.2, 0.7]],
+        };
+        let settings = Settings {
+            alpha: 0.5,
+            smoothing: 0.0,
+            min: 0.01,
+            max: 0.75,
+        };
+        // Median 1: a knot at twice the median is scaled by 2^-alpha, one at half by
+        // 2^alpha (and clamped to the packing limit).
+        let measured = vec![vec![1.0, 2.0, 1.0], vec![1.0, 1.0, 0.5]];
+        update_grid(&mut grid, &measured, &settings);
+        assert_eq!(grid.values[0][0], 0.2);
+        assert!((grid.values[0][1] - 0.2 / 2f64.sqrt()).abs() < 1e-15);
+        assert_eq!(grid.values[1][2], 0.75);
     }
 }

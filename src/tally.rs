@@ -11,6 +11,34 @@ use serde::{Deserialize, Serialize};
 const FRACTION_BITS: i32 = 64;
 const SCALE: f64 = 18446744073709551616.0; // 2^64
 
+/// Whether a merge adds another tally or takes one back out (exact: the sums are
+/// integers, so taking out a part of a total leaves exactly the sum of the other parts).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sign {
+    /// Add the other tally.
+    Add,
+    /// Take the other tally out (it must be part of this one).
+    Remove,
+}
+
+impl Sign {
+    /// `a += b` or `a -= b`.
+    pub fn apply_i128(self, a: &mut i128, b: i128) {
+        match self {
+            Sign::Add => *a += b,
+            Sign::Remove => *a -= b,
+        }
+    }
+
+    /// `a += b` or `a -= b` for counts.
+    pub fn apply_u64(self, a: &mut u64, b: u64) {
+        match self {
+            Sign::Add => *a += b,
+            Sign::Remove => *a -= b,
+        }
+    }
+}
+
 /// An exact sum of f64 contributions of either sign.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ExactSum(pub i128);
@@ -24,7 +52,12 @@ impl ExactSum {
 
     /// Add another exact sum.
     pub fn merge(&mut self, other: ExactSum) {
-        self.0 += other.0;
+        self.merge_signed(other, Sign::Add);
+    }
+
+    /// Add another exact sum, or take it out.
+    pub fn merge_signed(&mut self, other: ExactSum, sign: Sign) {
+        sign.apply_i128(&mut self.0, other.0);
     }
 
     /// The sum as f64.
@@ -54,9 +87,14 @@ impl BinStats {
 
     /// Merge another bin.
     pub fn merge(&mut self, o: &BinStats) {
-        self.sum.merge(o.sum);
-        self.sumsq.merge(o.sumsq);
-        self.hits += o.hits;
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Merge another bin, or take it out.
+    pub fn merge_signed(&mut self, o: &BinStats, sign: Sign) {
+        self.sum.merge_signed(o.sum, sign);
+        self.sumsq.merge_signed(o.sumsq, sign);
+        sign.apply_u64(&mut self.hits, o.hits);
     }
 
     /// Mean contribution per emitted photon and its standard error, for `n` photons
@@ -109,8 +147,13 @@ impl Grid {
 
     /// Merge another grid of the same shape.
     pub fn merge(&mut self, o: &Grid) {
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Merge another grid of the same shape, or take it out.
+    pub fn merge_signed(&mut self, o: &Grid, sign: Sign) {
         for (a, b) in self.bins.iter_mut().zip(&o.bins) {
-            a.merge(b);
+            a.merge_signed(b, sign);
         }
     }
 }
@@ -163,6 +206,21 @@ impl TryFrom<SparseGrid> for Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn taking_a_part_out_leaves_exactly_the_rest() {
+        let (mut a, mut b) = (Grid::new(3, 2), Grid::new(3, 2));
+        for k in 0..200 {
+            let w = 1.0 / (k as f64 + 0.37);
+            a.add(k % 3, k % 2, w);
+            b.add((k / 3) % 3, (k / 5) % 2, w * 1e-9);
+        }
+        let mut total = a.clone();
+        total.merge(&b);
+        assert_ne!(total, a);
+        total.merge_signed(&b, Sign::Remove);
+        assert_eq!(total, a);
+    }
 
     #[test]
     fn exact_sum_is_order_independent() {

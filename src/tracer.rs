@@ -19,7 +19,7 @@ use crate::geometry::Ray;
 use crate::optics::surface::{Estimator, MediumId, Outcome};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
-use crate::tally::{BinStats, ExactSum, Grid};
+use crate::tally::{BinStats, ExactSum, Grid, Sign};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -106,28 +106,27 @@ impl Ledger {
     }
 
     fn merge(&mut self, o: &Ledger) {
-        self.photons += o.photons;
-        self.interactions += o.interactions;
-        self.emitted.merge(o.emitted);
-        self.detected.merge(&o.detected);
-        for (a, b) in self
-            .absorbed_by_surface
-            .iter_mut()
-            .zip(&o.absorbed_by_surface)
-        {
-            a.merge(*b);
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Add another ledger, or take it out.
+    fn merge_signed(&mut self, o: &Ledger, sign: Sign) {
+        sign.apply_u64(&mut self.photons, o.photons);
+        sign.apply_u64(&mut self.interactions, o.interactions);
+        self.emitted.merge_signed(o.emitted, sign);
+        self.detected.merge_signed(&o.detected, sign);
+        for (mine, theirs) in [
+            (&mut self.absorbed_by_surface, &o.absorbed_by_surface),
+            (&mut self.absorbed_in_medium, &o.absorbed_in_medium),
+        ] {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                a.merge_signed(*b, sign);
+            }
         }
-        for (a, b) in self
-            .absorbed_in_medium
-            .iter_mut()
-            .zip(&o.absorbed_in_medium)
-        {
-            a.merge(*b);
-        }
-        self.escaped.merge(o.escaped);
-        self.killed.merge(o.killed);
-        self.killed_photons += o.killed_photons;
-        self.roulette.merge(o.roulette);
+        self.escaped.merge_signed(o.escaped, sign);
+        self.killed.merge_signed(o.killed, sign);
+        sign.apply_u64(&mut self.killed_photons, o.killed_photons);
+        self.roulette.merge_signed(o.roulette, sign);
     }
 
     /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances).
@@ -169,9 +168,14 @@ impl Tally {
 
     /// Add another tally of the same scene.
     pub fn merge(&mut self, o: &Tally) {
-        self.flux.merge(&o.flux);
-        self.angular.merge(&o.angular);
-        self.ledger.merge(&o.ledger);
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Add another tally of the same scene, or take out one that is part of this one.
+    pub fn merge_signed(&mut self, o: &Tally, sign: Sign) {
+        self.flux.merge_signed(&o.flux, sign);
+        self.angular.merge_signed(&o.angular, sign);
+        self.ledger.merge_signed(&o.ledger, sign);
     }
 
     /// Add the events of one traced chunk.

@@ -11,7 +11,7 @@
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
 
 use crate::scene::Scene;
-use crate::tally::Grid;
+use crate::tally::{Grid, Sign};
 use crate::tracer::Tally;
 use serde::Serialize;
 
@@ -251,13 +251,14 @@ pub fn jackknife(scene: &Scene, groups: &[Tally]) -> [f64; 8] {
     if k < 2 {
         return [f64::NAN; 8];
     }
-    let leave_out: Vec<[f64; 8]> = (0..k)
-        .map(|skip| {
-            let mut t = Tally::new(scene);
-            used.iter()
-                .enumerate()
-                .filter(|(i, _)| *i != skip)
-                .for_each(|(_, g)| t.merge(g));
+    let mut total = Tally::new(scene);
+    used.iter().for_each(|g| total.merge(g));
+    // Leaving a group out = taking it out of the total: exact, as the sums are integers.
+    let leave_out: Vec<[f64; 8]> = used
+        .iter()
+        .map(|g| {
+            let mut t = total.clone();
+            t.merge_signed(g, Sign::Remove);
             Metrics::of(scene, &t).named().map(|(_, v)| v)
         })
         .collect();

@@ -315,6 +315,16 @@ fn bench(scene: &Path, photons: u64, threads: Option<usize>, repeat: usize) -> R
         println!("| {name} | {q:.0} | {:.2} |", convex / q);
     }
     println!();
+    let large = blutrace::bench::large_mesh_table(scene, 1_000_000, repeat)?;
+    let obvhs = large.first().map_or(f64::NAN, |(_, _, q)| *q);
+    println!(
+        "| lamp-cavity nearest-hit queries, 540k-triangle mesh (1 thread) | triangles | queries/s | ratio to obvhs |"
+    );
+    println!("|---|---:|---:|---:|");
+    for (name, n, q) in &large {
+        println!("| {name} | {n} | {q:.0} | {:.2} |", q / obvhs);
+    }
+    println!();
     let rows = blutrace::bench::error_table(scene, 4.0, threads)?;
     println!(
         "| backend | estimator | photons in ~4 s | mean-flux error | per-bin error | FOM mean | FOM bins |"

@@ -227,23 +227,37 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         "efficiency {:.4} ± {:.4} of the emitted power reaches the target",
         s.extraction_efficiency, s.extraction_efficiency_stderr
     );
-    println!("flux       mean {:.4e} ± {:.1e} W/mm²", u.mean, e.mean);
     println!(
-        "uniformity cv {:.3} ± {:.3} (noise floor {:.3}, debiased {:.3}), min/max {:.3} ± {:.3}, 9-pt {:.3} ± {:.3}, 13-pt {:.3} ± {:.3}",
+        "flux       mean {:.4e} ± {} W/mm²",
+        u.mean,
+        err(e.mean, 1, true)
+    );
+    println!(
+        "uniformity cv {:.3} ± {} (noise floor {:.3}, debiased {:.3}), min/max {:.3} ± {}, 9-pt {:.3} ± {}, 13-pt {:.3} ± {}",
         u.cv,
-        e.cv,
+        err(e.cv, 3, false),
         s.cv_noise_floor,
         s.cv_debiased,
         u.min_over_max,
-        e.min_over_max,
+        err(e.min_over_max, 3, false),
         u.nine_point_min_over_max,
-        e.nine_point_min_over_max,
+        err(e.nine_point_min_over_max, 3, false),
         u.thirteen_point_min_over_max,
-        e.thirteen_point_min_over_max
+        err(e.thirteen_point_min_over_max, 3, false)
     );
+    if !e.cv.is_finite() {
+        let chunk = blutrace::tracer::CHUNK;
+        println!(
+            "note       errors of the map's metrics (jackknife over chunks of {chunk} photons) need at least {} photons; this run traced {}",
+            2 * chunk,
+            s.photons
+        );
+    }
     println!(
-        "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {:.3e} ({:?})",
-        s.mean_rel_stderr, s.figure_of_merit.efficiency, s.figure_of_merit.metric
+        "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {} ({:?})",
+        s.mean_rel_stderr,
+        err(s.figure_of_merit.efficiency, 3, true),
+        s.figure_of_merit.metric
     );
     if let Some(lum) = &s.luminance {
         println!(
@@ -253,6 +267,16 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     }
     for f in files {
         println!("wrote      {}", f.display());
+    }
+}
+
+/// An error estimate with `digits` decimals (scientific with `sci`), or `n/a` when the
+/// run was too short to estimate it.
+fn err(e: f64, digits: usize, sci: bool) -> String {
+    match (e.is_finite(), sci) {
+        (false, _) => "n/a".into(),
+        (true, true) => format!("{e:.digits$e}"),
+        (true, false) => format!("{e:.digits$}"),
     }
 }
 

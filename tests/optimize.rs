@@ -443,6 +443,11 @@ fn density_grid_in_scene_files() {
             "density_grid = { width_mm = -1.0, values = [[0.1], [0.2]] }",
             &["surfaces.dots.density_grid", "width_mm"][..],
         ),
+        (
+            "opt-grid-width-one-row",
+            "density_grid = { width_mm = -3.0, values = [[0.1, 0.2]] }",
+            &["surfaces.dots.density_grid", "width_mm"][..],
+        ),
     ] {
         let path = small_scene(name, text);
         let msg = format!("{:#}", Scene::load(&path).unwrap_err());

@@ -220,7 +220,8 @@ impl Density {
                         g.values[j].len()
                     ));
                 }
-                if !(g.width.is_finite() && (g.width > 0.0 || ny == 1)) {
+                // One row needs no span across; more rows need a positive one.
+                if !(g.width.is_finite() && (g.width > 0.0 || (ny == 1 && g.width == 0.0))) {
                     return Some(format!("width_mm must be positive, got {}", g.width));
                 }
                 if !g.v_min.is_finite() {

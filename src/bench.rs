@@ -22,6 +22,7 @@ use crate::geometry::Ray;
 use crate::optics::sampling;
 use crate::optics::surface::Estimator;
 use crate::rng::PhotonRng;
+use crate::run::metrics::median;
 use crate::run::{self, RunOptions};
 use crate::scene::Scene;
 use anyhow::Result;
@@ -78,7 +79,7 @@ pub fn trace_table(
             }
         }
     }
-    // rates[c]: (photons/s, interactions/s, backend name) of config c, one per round.
+    // rates[c]: (photons/s, interactions/s) of config c, one per round.
     let mut rates: Vec<Vec<(f64, f64)>> = vec![Vec::new(); configs.len()];
     let mut names = vec![""; configs.len()];
     for _ in 0..repeat.max(1) {
@@ -98,17 +99,14 @@ pub fn trace_table(
         }
     }
     let mut rows: Vec<BenchRow> = Vec::new();
+    // Each scene's configurations start with obvhs without the convex path: the reference.
+    let mut reference = f64::NAN;
     for (c, &(label, scene, backend, convex)) in configs.iter().enumerate() {
         let photons_per_s = median(rates[c].iter().map(|r| r.0).collect());
         let interactions_per_s = median(rates[c].iter().map(|r| r.1).collect());
-        let reference = if backend == BackendChoice::Bvh && !convex {
-            photons_per_s
-        } else {
-            rows.iter()
-                .rev()
-                .find(|r| r.scene == label && r.backend == "bvh" && !r.convex)
-                .map_or(f64::NAN, |r| r.photons_per_s)
-        };
+        if backend == BackendChoice::Bvh && !convex {
+            reference = photons_per_s;
+        }
         rows.push(BenchRow {
             scene: label.into(),
             triangles: scene.mesh.len(),
@@ -120,16 +118,6 @@ pub fn trace_table(
         });
     }
     Ok(rows)
-}
-
-/// The median of `values` (NaN when empty).
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    match values.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => values[n / 2],
-        n => 0.5 * (values[n / 2 - 1] + values[n / 2]),
-    }
 }
 
 /// Nearest-hit queries per second for rays inside the guide: each backend, and the convex
@@ -290,13 +278,6 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert!(median(Vec::new()).is_nan());
-    }
 
     #[test]
     fn tables_have_every_configuration_and_obvhs_as_reference() {

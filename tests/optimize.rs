@@ -700,6 +700,15 @@ fn options_of_one_method_are_refused_by_the_other() {
             },
             "--cells needs --method feedback --dims 2",
         ),
+        (
+            OptimizeOptions {
+                method: Method::Feedback,
+                dims: 2,
+                cells: Some((1, 4)),
+                ..base.clone()
+            },
+            "--cells needs at least 2 knots each way",
+        ),
     ] {
         let err = optimize(&scene, &options, &mut |_| {}).err();
         let msg = format!("{:#}", err.expect("refused"));

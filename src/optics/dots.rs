@@ -177,6 +177,15 @@ impl DensityGrid {
 }
 
 impl Density {
+    /// The density at the polynomial variable `x` and `v` mm across the axis: a grid
+    /// uses both, the other densities only `x`.
+    pub fn at(&self, x: f64, v: f64) -> f64 {
+        match self {
+            Density::Grid(g) => g.at(x, v),
+            other => other.eval(x),
+        }
+    }
+
     /// The density at the polynomial variable `x` (a grid's mean across the axis).
     pub fn eval(&self, x: f64) -> f64 {
         match self {
@@ -352,10 +361,7 @@ impl DotPattern {
     /// The density at face coordinates `c` (mm along `axis`, mm along `across`): a grid
     /// uses both, the other densities only the first.
     pub fn density_at_point(&self, c: DVec2) -> f64 {
-        match &self.density {
-            Density::Grid(g) => g.at(self.x_of(c.x), c.y),
-            _ => self.density_at(c.x),
-        }
+        self.density.at(self.x_of(c.x), c.y)
     }
 
     /// Radius (mm) of the dot of the cell centred at face coordinates `c`.

@@ -160,14 +160,13 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
     }
     let options = args.options(&scene);
     let out = args.out.clone().unwrap_or_else(|| {
-        let two = options.method == Method::Feedback && options.dims == 2;
-        let suffix = if two { "-2d" } else { "" };
+        let suffix = if options.tunes_grid() { "-2d" } else { "" };
         PathBuf::from("out").join(format!(
             "{}-optimize-{}{suffix}",
             scene.name, options.method
         ))
     });
-    let objective = if options.method == Method::Feedback && options.dims == 2 {
+    let objective = if options.tunes_grid() {
         "area cv of the flux map (2-D density grid)"
     } else {
         "cv of the flux profile along the axis"

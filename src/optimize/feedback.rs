@@ -34,8 +34,8 @@
 //! ```
 
 use super::objective::Profile;
-use crate::optics::dots::{Density, DensityGrid, DotPattern};
-use crate::run::metrics::Map;
+use crate::optics::dots::{DensityGrid, DotPattern};
+use crate::run::metrics::{Map, median};
 use crate::scene::Scene;
 
 /// The search stops after this many rounds in a row that do not beat the best objective
@@ -97,6 +97,21 @@ pub fn measured_per_knot(pattern: &DotPattern, knots: &[f64], profile: &Profile)
         .collect()
 }
 
+/// `d (target / measured)^alpha`, the ratio limited to `[1/4, 4]`, clamped to `[min, max]`;
+/// a dark knot (no flux at all) gets the largest step the damping allows, one without a
+/// measurement (NaN) keeps its density.
+fn damped_step(d: f64, measured: f64, target: f64, s: &Settings) -> f64 {
+    if measured.is_nan() {
+        return d;
+    }
+    let ratio = if measured > 0.0 {
+        target / measured
+    } else {
+        4.0
+    };
+    (d * ratio.clamp(0.25, 4.0).powf(s.alpha)).clamp(s.min, s.max)
+}
+
 /// One feedback update of the knot densities `d` from a traced profile.
 pub fn update(pattern: &DotPattern, knots: &[f64], d: &mut [f64], profile: &Profile, s: &Settings) {
     let target = profile.median();
@@ -105,12 +120,7 @@ pub fn update(pattern: &DotPattern, knots: &[f64], d: &mut [f64], profile: &Prof
         return;
     }
     for (dj, m) in d.iter_mut().zip(&measured) {
-        if m.is_nan() {
-            continue;
-        }
-        // A dark strip (no flux at all) gets the largest step the damping allows.
-        let ratio = if *m > 0.0 { target / m } else { 4.0 };
-        *dj = (*dj * ratio.clamp(0.25, 4.0).powf(s.alpha)).clamp(s.min, s.max);
+        *dj = damped_step(*dj, *m, target, s);
     }
     if s.smoothing > 0.0 && d.len() > 2 {
         let old = d.to_vec();
@@ -126,7 +136,8 @@ pub fn update(pattern: &DotPattern, knots: &[f64], d: &mut [f64], profile: &Prof
     }
 }
 
-/// The density grid the 2-D feedback starts from: `nx` x `ny` knots over the pattern's
+/// The density grid the 2-D feedback starts from: `nx` x `ny` knots (at least 2 each
+/// way, see `check_method_options`) over the pattern's
 /// span of x and `v_min..=v_min + width` across, valued as `pattern`'s own density at each
 /// knot (clamped to `[min, max]`).
 pub fn initial_grid(
@@ -137,7 +148,6 @@ pub fn initial_grid(
     min: f64,
     max: f64,
 ) -> DensityGrid {
-    let (nx, ny) = (nx.max(2), ny.max(2));
     let x_max = pattern.x_max();
     let values = (0..ny)
         .map(|j| {
@@ -145,11 +155,7 @@ pub fn initial_grid(
             (0..nx)
                 .map(|i| {
                     let x = x_max * i as f64 / (nx - 1) as f64;
-                    let d = match &pattern.density {
-                        Density::Grid(g) => g.at(x, v),
-                        other => other.eval(x),
-                    };
-                    d.clamp(min, max)
+                    pattern.density.at(x, v).clamp(min, max)
                 })
                 .collect()
         })
@@ -212,20 +218,14 @@ pub fn measured_per_cell(
 pub fn fill_empty_cells(values: &mut [Vec<f64>]) {
     loop {
         let old = values.to_vec();
-        let mut filled = false;
-        let mut empty = false;
+        let (mut filled, mut empty) = (false, false);
         for (j, row) in values.iter_mut().enumerate() {
             for (i, v) in row.iter_mut().enumerate().filter(|(_, v)| v.is_nan()) {
-                let neighbours: Vec<f64> = old[j.saturating_sub(1)..(j + 2).min(old.len())]
-                    .iter()
-                    .flat_map(|r| &r[i.saturating_sub(1)..(i + 2).min(r.len())])
-                    .copied()
-                    .filter(|m| m.is_finite())
-                    .collect();
-                if neighbours.is_empty() {
+                let measured: Vec<f64> = neighbours(&old, i, j).filter(|m| m.is_finite()).collect();
+                if measured.is_empty() {
                     empty = true;
                 } else {
-                    *v = neighbours.iter().sum::<f64>() / neighbours.len() as f64;
+                    *v = measured.iter().sum::<f64>() / measured.len() as f64;
                     filled = true;
                 }
             }
@@ -236,59 +236,45 @@ pub fn fill_empty_cells(values: &mut [Vec<f64>]) {
     }
 }
 
+/// The (up to 8) values around `[j][i]` in its 3 x 3 window.
+fn neighbours(values: &[Vec<f64>], i: usize, j: usize) -> impl Iterator<Item = f64> + '_ {
+    let rows = j.saturating_sub(1)..(j + 2).min(values.len());
+    rows.flat_map(move |jj| {
+        let row = &values[jj];
+        let cols = i.saturating_sub(1)..(i + 2).min(row.len());
+        cols.filter(move |&ii| (ii, jj) != (i, j))
+            .map(move |ii| row[ii])
+    })
+}
+
 /// One 2-D feedback update of the grid's knots from the flux per knot cell: every knot
 /// gets `d <- d (target / measured)^alpha` with `target` the median over the cells, is
 /// clamped to `[min, max]`, then optionally smoothed with the mean of its (up to 8)
 /// neighbours in a 3 x 3 kernel.
 pub fn update_grid(grid: &mut DensityGrid, measured: &[Vec<f64>], s: &Settings) {
-    let mut all: Vec<f64> = measured
+    let all: Vec<f64> = measured
         .iter()
         .flatten()
         .copied()
         .filter(|m| m.is_finite())
         .collect();
-    if all.is_empty() {
-        return;
-    }
-    all.sort_by(f64::total_cmp);
-    let m = all.len() / 2;
-    let target = if all.len() % 2 == 1 {
-        all[m]
-    } else {
-        0.5 * (all[m - 1] + all[m])
-    };
+    let target = median(all);
     if !(target > 0.0 && target.is_finite()) {
         return;
     }
     for (row, mrow) in grid.values.iter_mut().zip(measured) {
         for (dj, m) in row.iter_mut().zip(mrow) {
-            if m.is_nan() {
-                continue;
-            }
-            let ratio = if *m > 0.0 { target / m } else { 4.0 };
-            *dj = (*dj * ratio.clamp(0.25, 4.0).powf(s.alpha)).clamp(s.min, s.max);
+            *dj = damped_step(*dj, *m, target, s);
         }
     }
-    let (nx, ny) = grid.shape();
-    if s.smoothing > 0.0 && nx * ny > 2 {
+    if s.smoothing > 0.0 {
         let old = grid.values.clone();
-        for j in 0..ny {
-            for i in 0..nx {
-                let (mut sum, mut n) = (0.0, 0usize);
-                let rows = j.saturating_sub(1)..=(j + 1).min(ny - 1);
-                for (jj, row) in old.iter().enumerate().filter(|(jj, _)| rows.contains(jj)) {
-                    let cols = i.saturating_sub(1)..=(i + 1).min(nx - 1);
-                    for (ii, v) in row.iter().enumerate().filter(|(ii, _)| cols.contains(ii)) {
-                        if (ii, jj) != (i, j) {
-                            sum += v;
-                            n += 1;
-                        }
-                    }
-                }
-                if n > 0 {
-                    let mean = sum / n as f64;
-                    grid.values[j][i] =
-                        ((1.0 - s.smoothing) * old[j][i] + s.smoothing * mean).clamp(s.min, s.max);
+        for (j, row) in grid.values.iter_mut().enumerate() {
+            for (i, v) in row.iter_mut().enumerate() {
+                let around: Vec<f64> = neighbours(&old, i, j).collect();
+                if !around.is_empty() {
+                    let mean = around.iter().sum::<f64>() / around.len() as f64;
+                    *v = ((1.0 - s.smoothing) * old[j][i] + s.smoothing * mean).clamp(s.min, s.max);
                 }
             }
         }

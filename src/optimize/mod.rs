@@ -136,6 +136,13 @@ pub struct OptimizeOptions {
     pub estimator: Estimator,
 }
 
+impl OptimizeOptions {
+    /// True for the 2-D feedback, which tunes a density grid over the whole face.
+    pub fn tunes_grid(&self) -> bool {
+        self.method == Method::Feedback && self.dims == 2
+    }
+}
+
 impl Default for OptimizeOptions {
     fn default() -> Self {
         Self {
@@ -266,7 +273,7 @@ impl TracedRun {
         let evaluation = Evaluation::of(
             &scene,
             pattern,
-            &r.flux_map(),
+            r.flux_map(),
             strips,
             margin,
             r.tally.ledger.photons,
@@ -580,7 +587,7 @@ impl<'a> Search<'a> {
     /// `sqrt(cv^2 - floor^2)` (per-bin noise dominates the raw area cv at few photons),
     /// else the profile cv.
     fn score(&self, ev: &Evaluation) -> (f64, f64) {
-        if self.options.method == Method::Feedback && self.options.dims == 2 {
+        if self.options.tunes_grid() {
             let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
                 .max(0.0)
                 .sqrt();
@@ -847,13 +854,6 @@ fn run_feedback(search: &mut Search, progress: &mut dyn FnMut(&IterationReport))
         }
         2 => {
             let cells = search.options.cells.unwrap_or((56, 28));
-            if cells.0 < 2 || cells.1 < 2 {
-                bail!(
-                    "--cells needs at least 2 knots each way, got {},{}",
-                    cells.0,
-                    cells.1
-                );
-            }
             let (v_lo, v_hi) = match &p.density {
                 Density::Grid(g) => (g.v_min, g.v_min + g.width),
                 _ => face_v_range(search),
@@ -984,14 +984,16 @@ fn check_method_options(options: &OptimizeOptions) -> Result<()> {
     if !(1..=2).contains(&options.dims) {
         bail!("--dims must be 1 or 2, got {}", options.dims);
     }
-    let grid = options.method == Method::Feedback && options.dims == 2;
-    if options.dims == 2 && !grid {
+    if options.dims == 2 && !options.tunes_grid() {
         bail!("--dims 2 needs --method feedback (Nelder-Mead tunes a polynomial along the axis)");
     }
-    if options.cells.is_some() && !grid {
-        bail!("--cells needs --method feedback --dims 2");
+    match options.cells {
+        Some(_) if !options.tunes_grid() => bail!("--cells needs --method feedback --dims 2"),
+        Some((nx, ny)) if nx < 2 || ny < 2 => {
+            bail!("--cells needs at least 2 knots each way, got {nx},{ny}")
+        }
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// The feedback settings of `search`'s options, checked.

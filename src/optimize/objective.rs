@@ -15,7 +15,7 @@
 //! numbers), so two designs are compared on the same photon histories.
 
 use crate::optics::dots::DotPattern;
-use crate::run::metrics::{Map, Uniformity};
+use crate::run::metrics::{Map, Uniformity, median};
 use crate::scene::Scene;
 use serde::Serialize;
 
@@ -138,17 +138,7 @@ impl Profile {
 
     /// Median of the used strips' values.
     pub fn median(&self) -> f64 {
-        let mut v: Vec<f64> = self.used_values().map(|(v, _)| v).collect();
-        if v.is_empty() {
-            return f64::NAN;
-        }
-        v.sort_by(f64::total_cmp);
-        let m = v.len() / 2;
-        if v.len() % 2 == 1 {
-            v[m]
-        } else {
-            0.5 * (v[m - 1] + v[m])
-        }
+        median(self.used_values().map(|(v, _)| v).collect())
     }
 }
 
@@ -185,13 +175,13 @@ impl Evaluation {
     pub fn of(
         scene: &Scene,
         pattern: &DotPattern,
-        map: &Map,
+        map: Map,
         strips: usize,
         margin: f64,
         photons: u64,
         seconds: f64,
     ) -> Self {
-        let profile = Profile::of(scene, pattern, map, strips, margin);
+        let profile = Profile::of(scene, pattern, &map, strips, margin);
         let (objective, noise, noise_floor) = profile.cv();
         let (mut v, mut e) = (Vec::new(), Vec::new());
         for (i, k) in strip_of_bins(scene, pattern, map.nx, map.ny, strips)
@@ -209,13 +199,13 @@ impl Evaluation {
             noise,
             noise_floor,
             profile,
-            uniformity: Uniformity::of(map),
+            uniformity: Uniformity::of(&map),
             area_cv,
             area_cv_noise,
             area_noise_floor,
             photons,
             seconds,
-            map: map.clone(),
+            map,
         }
     }
 }

@@ -243,6 +243,16 @@ impl Metrics {
     }
 }
 
+/// The median of `values` (NaN when empty).
+pub fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    match values.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => values[n / 2],
+        n => 0.5 * (values[n / 2 - 1] + values[n / 2]),
+    }
+}
+
 /// Jackknife standard errors of every named metric from the per-group tallies.
 /// Returns NaN errors when fewer than two groups hold photons.
 pub fn jackknife(scene: &Scene, groups: &[Tally]) -> [f64; 8] {

@@ -302,11 +302,7 @@ impl DotPattern {
     /// The polynomial variable at the far end of the span (1 when normalized, else the
     /// span in mm: the length, or half of it when mirrored).
     pub fn x_max(&self) -> f64 {
-        self.x_of(if self.mirror {
-            0.5 * self.length
-        } else {
-            self.length
-        })
+        super::gradation::graded_x_max(self.length, self.x_unit, self.mirror)
     }
 
     /// Check that the density is finite and within `[0, max packing]` along the whole

@@ -26,6 +26,13 @@ pub fn graded_x(u: f64, length: f64, unit: XUnit, mirror: bool) -> f64 {
     }
 }
 
+/// The grading variable at the far end of a span of `length` (mm): 1 when normalized,
+/// else the span in mm (the length, or half of it when `mirror`).
+pub fn graded_x_max(length: f64, unit: XUnit, mirror: bool) -> f64 {
+    let end = if mirror { 0.5 * length } else { length };
+    graded_x(end, length, unit, mirror)
+}
+
 /// A function graded along an axis of span `length` (mm).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Gradation {

@@ -548,16 +548,8 @@ fn build_surface(
                 (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
                 (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
                 (None, None, Some(g)) => {
-                    let x_max = crate::optics::gradation::graded_x(
-                        if *mirror {
-                            0.5 * *length_mm
-                        } else {
-                            *length_mm
-                        },
-                        *length_mm,
-                        *x_unit,
-                        *mirror,
-                    );
+                    let x_max =
+                        crate::optics::gradation::graded_x_max(*length_mm, *x_unit, *mirror);
                     let grid = DensityGrid {
                         x_max,
                         v_min: g.v_min_mm,

@@ -242,6 +242,11 @@ impl<'a> Checker<'a> {
             (None, None) => Ok(Verdict::Same),
             (Some(w), Some(g)) => {
                 let tol = self.tol(ray, w.prim, w.t);
+                let g_tol = self.tol(ray, g.prim, g.t);
+                if g.t < w.t - tol && self.on_shared_edge(ray.at(g.t), g.prim, g_tol) {
+                    // The oracle slipped through a shared edge nearer than its hit.
+                    return Ok(Verdict::OracleLeak);
+                }
                 if (g.t - w.t).abs() > tol {
                     return Err(format!(
                         "distance {} vs oracle {} (prims {} / {}, tol {tol:.3e})",

@@ -98,3 +98,37 @@ pub fn within_sigma(k: f64, n: f64, p: f64, z: f64) -> (f64, f64, bool) {
     let sigma = (p * (1.0 - p) / n).sqrt();
     (frac, sigma, (frac - p).abs() <= z * sigma)
 }
+
+/// A small edge-lit plate with graded dots, an absorbing PMMA and a Lambert back sheet.
+pub fn plate_scene(name: &str) -> Scene {
+    let led = "[[sources]]\ntype = \"led\"\ncenter = [-10.001, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\n\
+               u = [0.0, 1.0, 0.0]\nwidth_mm = 10.0\nheight_mm = 0.5\npower_w = 2.0\n";
+    let plate = box_obj(
+        [-10.0, -10.0, -0.5],
+        [10.0, 10.0, 0.5],
+        ["edge", "edge", "edge", "edge", "dots", "face"],
+    );
+    let sheet = "v -12 -12 -0.7\nv 12 -12 -0.7\nv 12 12 -0.7\nv -12 12 -0.7\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"plate.obj\"\n[[geometry]]\nfile = \"sheet.obj\"\n\
+         [media.pmma]\nn = 1.49\nabsorption_per_mm = 0.02\n\
+         [surfaces.face]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.8\n\
+         [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.7\nlattice = \"square\"\npitch_mm = 0.5\n\
+         origin = [-10.0, 0.0, -0.5]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 20.0\ndensity = [0.1, 0.4]\n{led}\
+         [detector]\norigin = [-10.0, -10.0, 0.6]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [20.0, 20.0]\n\
+         bins = [10, 10]\nangular_bins = [6, 8]\n"
+    );
+    load(&write_scene(
+        name,
+        &toml,
+        &[("plate.obj", &plate), ("sheet.obj", sheet)],
+    ))
+}
+
+/// Wilson-Hilferty: the chi-square quantile for `k` degrees of freedom at normal score `z`.
+pub fn chi2_quantile(k: f64, z: f64) -> f64 {
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + z * a.sqrt()).powi(3)
+}

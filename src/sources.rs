@@ -26,6 +26,7 @@
 //! An LED with `intensity_file` becomes an [`Emitter::MeasuredLed`]; see [`intensity`]
 //! for the CSV and IES LM-63 formats and how the table is sampled.
 
+pub mod body;
 pub mod intensity;
 
 use crate::geometry::{Ray, orthonormal_basis};

@@ -7,7 +7,9 @@
 
 pub mod accel;
 pub mod bench;
+pub mod cli_enums;
 pub mod detector;
+pub mod estimator;
 pub mod geometry;
 pub mod optics;
 pub mod optimize;
@@ -17,5 +19,6 @@ pub mod run;
 pub mod scene;
 pub mod shard;
 pub mod sources;
+pub mod spec_check;
 pub mod tally;
 pub mod tracer;

@@ -30,10 +30,49 @@
 //! exact) and `alpha -> 0` gives back the smooth Fresnel interface.
 
 use super::fresnel;
+use super::medium::{Interface, Medium, air};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
+
+/// Largest accepted diffuser roughness (GGX alpha; a facet tilt of 76 deg at a quarter of
+/// the peak density). Rougher faces are not surface diffusers any more.
+pub const MAX_ROUGHNESS: f64 = 4.0;
+
+/// `[surfaces.TAG]` with `model = "diffuser"`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiffuserSpec {
+    /// Medium behind the face.
+    pub inside: String,
+    /// Medium in front of the face.
+    #[serde(default = "air")]
+    pub outside: String,
+    /// GGX roughness alpha (0: smooth).
+    pub roughness: f64,
+}
+
+impl DiffuserSpec {
+    /// Check `[surfaces.TAG]` and build its model: the interface and the roughness.
+    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<(Interface, f64)> {
+        let field = format!("surfaces.{tag}.roughness");
+        let alpha = ctx.non_negative(&field, self.roughness)?;
+        if alpha > MAX_ROUGHNESS {
+            return Err(ctx.err(
+                &field,
+                format!("must be at most {MAX_ROUGHNESS} (GGX alpha), got {alpha}"),
+            ));
+        }
+        Ok((
+            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
+            alpha,
+        ))
+    }
+}
 
 /// Micro-facet events at one hit before the model gives up (mirror at the mean plane).
 pub const MAX_EVENTS: usize = 64;
@@ -89,18 +128,15 @@ pub fn scatter(
             (n_outside, n_inside)
         };
         let m = sample_visible_normal(facing, -d, alpha, rng.uniform(), rng.uniform());
-        let cos_i = -d.dot(m);
-        if cos_i <= 0.0 {
+        if -d.dot(m) <= 0.0 {
             continue; // a facet seen edge-on (rounding): draw another
         }
-        let r = fresnel::reflectance(cos_i, n1, n2);
-        if r >= 1.0 || rng.uniform() < r {
-            d = fresnel::reflect(d, m).normalize();
-        } else if let Some(t) = fresnel::refract(d, m, n1, n2) {
-            d = t;
-            inside = !inside;
-        } else {
-            d = fresnel::reflect(d, m).normalize();
+        match fresnel::roulette(d, m, n1, n2, rng) {
+            Some(t) => {
+                d = t;
+                inside = !inside;
+            }
+            None => d = fresnel::reflect(d, m).normalize(),
         }
     }
     let facing = if inside { -normal } else { normal };

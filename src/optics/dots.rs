@@ -39,8 +39,114 @@
 //! density_grid = { width_mm = 68.0, values = [[0.02, 0.1, 0.5], [0.03, 0.12, 0.6]] }
 //! ```
 
+pub use super::density::{Density, DensityGrid, XUnit};
+use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};
+use super::medium::{Interface, Medium, air};
+use crate::spec_check::Ctx;
+use anyhow::Result;
 use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+
+/// `[surfaces.TAG]` with `model = "dots"`: a dielectric face printed with ink dots.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DotsSpec {
+    /// Medium behind the face.
+    pub inside: String,
+    /// Medium in front of the face.
+    #[serde(default = "air")]
+    pub outside: String,
+    /// Ink albedo (Lambertian).
+    pub ink_albedo: f64,
+    /// Cell lattice.
+    pub lattice: Lattice,
+    /// Cell pitch (mm).
+    pub pitch_mm: f64,
+    /// A point on the lamp edge, in the face.
+    pub origin: [f64; 3],
+    /// Propagation direction.
+    pub axis: [f64; 3],
+    /// In-face direction across `axis` (default: face normal x axis, found at load).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub across: Option<[f64; 3]>,
+    /// Span along `axis` (mm).
+    pub length_mm: f64,
+    /// Density polynomial coefficients, lowest degree first (or `density_table`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<Vec<f64>>,
+    /// Tabulated density: knots `[x, d]`, x increasing, linear between (or `density`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_table: Option<Vec<[f64; 2]>>,
+    /// Density on a grid of knots over the face, bilinear (or `density`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_grid: Option<DensityGridSpec>,
+    /// Unit of the polynomial variable.
+    #[serde(default)]
+    pub x_unit: XUnit,
+    /// Lamps on both edges: measure from the nearer.
+    #[serde(default)]
+    pub mirror: bool,
+}
+
+/// A checked dots surface: the interface outside the dots, the dot layout (its `across`
+/// still zero when the file leaves it to the face, see [`DotPattern::fit_to_face`]) and
+/// the ink albedo.
+pub type Dots = (Interface, DotPattern, f64);
+
+impl DotsSpec {
+    /// Check `[surfaces.TAG]` and build its model.
+    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<Dots> {
+        let f = |k: &str| format!("surfaces.{tag}.{k}");
+        let (density, field) = match (&self.density, &self.density_table, &self.density_grid) {
+            (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
+            (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
+            (None, None, Some(g)) => {
+                let x_max = graded_x_max(self.length_mm, self.x_unit, self.mirror);
+                (Density::Grid(g.grid(x_max)), f("density_grid"))
+            }
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) | (_, Some(_), Some(_)) => {
+                return Err(ctx.err(
+                    &f("density"),
+                    "give only one of density (polynomial), density_table and density_grid",
+                ));
+            }
+            (None, None, None) => {
+                return Err(ctx.err(
+                    &f("density"),
+                    "missing: give density (polynomial coefficients), density_table ([x, d] knots) or density_grid",
+                ));
+            }
+        };
+        let density = density.checked(ctx, &field)?;
+        let lattice = self.lattice;
+        let pattern = DotPattern {
+            lattice,
+            pitch: ctx.positive(&f("pitch_mm"), self.pitch_mm)?,
+            origin: ctx.point(&f("origin"), self.origin)?,
+            axis: ctx.direction(&f("axis"), self.axis)?,
+            across: match self.across {
+                Some(a) => ctx.direction(&f("across"), a)?,
+                None => DVec3::ZERO,
+            },
+            length: ctx.positive(&f("length_mm"), self.length_mm)?,
+            density,
+            x_unit: self.x_unit,
+            mirror: self.mirror,
+        };
+        if let Some((u, d)) = pattern.first_out_of_range() {
+            return Err(ctx.err(&field, format!(
+                "d(x) = {d:.4} at {u:.3} mm from the origin is outside [0, {:.4}] (the {:?} lattice's packing limit)",
+                lattice.max_packing(), lattice
+            )));
+        }
+        Ok((
+            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
+            pattern,
+            ctx.fraction(&f("ink_albedo"), self.ink_albedo)?,
+        ))
+    }
+}
 
 /// Cell lattice of the dot grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -75,196 +181,6 @@ impl Lattice {
     }
 }
 
-/// How the polynomial's variable is measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum XUnit {
-    /// Distance divided by the span from the lamp edge to the far edge (or to the centre
-    /// line when mirrored): x in `[0, 1]`.
-    #[default]
-    Normalized,
-    /// Distance in millimetres.
-    Mm,
-}
-
-/// The density function d(x): the area fraction of a cell covered by its dot.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Density {
-    /// Polynomial coefficients, lowest degree first: `d(x) = c0 + c1 x + c2 x^2 + ...`.
-    Polynomial(Vec<f64>),
-    /// Knots `[x, d]`, `x` strictly increasing: linear between knots, constant beyond
-    /// the first and the last.
-    Table(Vec<[f64; 2]>),
-    /// Knots on a regular grid over the face (along the axis and across it), bilinear.
-    Grid(DensityGrid),
-}
-
-/// A density on a regular grid of knots: along the axis in the polynomial variable
-/// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct DensityGrid {
-    /// The polynomial variable at the last column of knots.
-    pub x_max: f64,
-    /// Position across the axis (mm from the origin along `across`) of the first row.
-    pub v_min: f64,
-    /// Span across the axis (mm) from the first to the last row.
-    pub width: f64,
-    /// `values[j][i]`: row `j` across the axis, column `i` along it.
-    pub values: Vec<Vec<f64>>,
-}
-
-impl DensityGrid {
-    /// Columns (knots along the axis) and rows (across it).
-    pub fn shape(&self) -> (usize, usize) {
-        (self.values.first().map_or(0, Vec::len), self.values.len())
-    }
-
-    /// Fractional knot coordinates of `(x, v)`, clamped to the grid.
-    fn knot_coords(&self, x: f64, v: f64) -> (f64, f64) {
-        let (nx, ny) = self.shape();
-        let fx = if nx > 1 && self.x_max > 0.0 {
-            (x / self.x_max * (nx - 1) as f64).clamp(0.0, (nx - 1) as f64)
-        } else {
-            0.0
-        };
-        let fy = if ny > 1 && self.width > 0.0 {
-            ((v - self.v_min) / self.width * (ny - 1) as f64).clamp(0.0, (ny - 1) as f64)
-        } else {
-            0.0
-        };
-        (fx, fy)
-    }
-
-    /// The knot nearest to `(x, v)`: (column, row).
-    pub fn nearest_knot(&self, x: f64, v: f64) -> (usize, usize) {
-        let (fx, fy) = self.knot_coords(x, v);
-        (fx.round() as usize, fy.round() as usize)
-    }
-
-    /// Bilinear interpolation at `(x, v)`, constant beyond the grid.
-    pub fn at(&self, x: f64, v: f64) -> f64 {
-        let (nx, ny) = self.shape();
-        if nx == 0 || ny == 0 {
-            return 0.0;
-        }
-        let (fx, fy) = self.knot_coords(x, v);
-        let (i0, j0) = (
-            (fx.floor() as usize).min(nx - 1),
-            (fy.floor() as usize).min(ny - 1),
-        );
-        let (i1, j1) = ((i0 + 1).min(nx - 1), (j0 + 1).min(ny - 1));
-        let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
-        let g = |i: usize, j: usize| self.values[j][i];
-        let a = g(i0, j0) + (g(i1, j0) - g(i0, j0)) * tx;
-        let b = g(i0, j1) + (g(i1, j1) - g(i0, j1)) * tx;
-        a + (b - a) * ty
-    }
-
-    /// The mean over the rows at `x` (the density averaged across the axis).
-    pub fn row_mean(&self, x: f64) -> f64 {
-        let (_, ny) = self.shape();
-        if ny == 0 {
-            return 0.0;
-        }
-        (0..ny)
-            .map(|j| {
-                let v = self.v_min + self.width * j as f64 / (ny - 1).max(1) as f64;
-                self.at(x, v)
-            })
-            .sum::<f64>()
-            / ny as f64
-    }
-}
-
-impl Density {
-    /// The density at the polynomial variable `x` and `v` mm across the axis: a grid
-    /// uses both, the other densities only `x`.
-    pub fn at(&self, x: f64, v: f64) -> f64 {
-        match self {
-            Density::Grid(g) => g.at(x, v),
-            other => other.eval(x),
-        }
-    }
-
-    /// The density at the polynomial variable `x` (a grid's mean across the axis).
-    pub fn eval(&self, x: f64) -> f64 {
-        match self {
-            Density::Polynomial(c) => c.iter().rev().fold(0.0, |acc, c| acc * x + c),
-            Density::Table(knots) => interpolate(knots, x),
-            Density::Grid(g) => g.row_mean(x),
-        }
-    }
-
-    /// Why this density cannot be used (empty, non-finite, knots not increasing), if so.
-    pub fn problem(&self) -> Option<String> {
-        match self {
-            Density::Polynomial(c) if c.is_empty() => Some("needs at least one coefficient".into()),
-            Density::Polynomial(c) => c
-                .iter()
-                .position(|v| !v.is_finite())
-                .map(|i| format!("coefficient {i} is not a finite number")),
-            Density::Table(k) if k.is_empty() => Some("needs at least one knot".into()),
-            Density::Table(k) => {
-                if let Some(i) = k
-                    .iter()
-                    .position(|p| !p[0].is_finite() || !p[1].is_finite())
-                {
-                    return Some(format!("knot {i} is not a pair of finite numbers"));
-                }
-                k.windows(2).position(|w| w[1][0] <= w[0][0]).map(|i| {
-                    format!(
-                        "knot x values must increase strictly (knots {i} and {})",
-                        i + 1
-                    )
-                })
-            }
-            Density::Grid(g) => {
-                let (nx, ny) = g.shape();
-                if nx == 0 || ny == 0 {
-                    return Some("needs at least one row of values".into());
-                }
-                if let Some(j) = g.values.iter().position(|r| r.len() != nx) {
-                    return Some(format!(
-                        "values must be rectangular: row {j} has {} values, row 0 has {nx}",
-                        g.values[j].len()
-                    ));
-                }
-                // One row needs no span across; more rows need a positive one.
-                if !(g.width.is_finite() && (g.width > 0.0 || (ny == 1 && g.width == 0.0))) {
-                    return Some(format!("width_mm must be positive, got {}", g.width));
-                }
-                if !g.v_min.is_finite() {
-                    return Some("v_min_mm is not a finite number".into());
-                }
-                for (j, r) in g.values.iter().enumerate() {
-                    if let Some(i) = r.iter().position(|v| !v.is_finite()) {
-                        return Some(format!("values[{j}][{i}] is not a finite number"));
-                    }
-                }
-                None
-            }
-        }
-    }
-}
-
-/// Piecewise-linear interpolation through `knots` (x increasing), constant outside.
-fn interpolate(knots: &[[f64; 2]], x: f64) -> f64 {
-    let Some(first) = knots.first() else {
-        return 0.0;
-    };
-    let last = knots[knots.len() - 1];
-    if x <= first[0] {
-        return first[1];
-    }
-    if x >= last[0] {
-        return last[1];
-    }
-    // First knot strictly right of x; exists and is > 0 because first[0] < x < last[0].
-    let i = knots.partition_point(|k| k[0] <= x);
-    let (a, b) = (knots[i - 1], knots[i]);
-    a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0])
-}
-
 /// A dot pattern placed on a face.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DotPattern {
@@ -291,7 +207,7 @@ pub struct DotPattern {
 impl DotPattern {
     /// The polynomial variable at distance `u` (mm) along the axis from the origin.
     pub fn x_of(&self, u: f64) -> f64 {
-        super::gradation::graded_x(u, self.length, self.x_unit, self.mirror)
+        graded_x(u, self.length, self.x_unit, self.mirror)
     }
 
     /// The density (area fraction) at distance `u` (mm) along the axis.
@@ -302,28 +218,46 @@ impl DotPattern {
     /// The polynomial variable at the far end of the span (1 when normalized, else the
     /// span in mm: the length, or half of it when mirrored).
     pub fn x_max(&self) -> f64 {
-        super::gradation::graded_x_max(self.length, self.x_unit, self.mirror)
+        graded_x_max(self.length, self.x_unit, self.mirror)
     }
 
     /// Check that the density is finite and within `[0, max packing]` along the whole
     /// span. Returns the first offending position (mm) and value.
     pub fn first_out_of_range(&self) -> Option<(f64, f64)> {
-        let max = self.lattice.max_packing();
-        if let Density::Grid(g) = &self.density {
-            // Bilinear values lie between the knots': checking the knots is enough.
-            let (nx, _) = g.shape();
-            return g.values.iter().flatten().enumerate().find_map(|(k, &d)| {
-                let i = k % nx.max(1);
-                let u = self.length * i as f64 / (nx - 1).max(1) as f64;
-                let u = if self.mirror { 0.5 * u } else { u };
-                (!d.is_finite() || !(0.0..=max).contains(&d)).then_some((u, d))
-            });
+        self.gradation()
+            .first_outside(0.0, self.lattice.max_packing())
+    }
+
+    /// The density graded along the span, as the range check sees it.
+    fn gradation(&self) -> Gradation {
+        Gradation {
+            density: self.density.clone(),
+            length: self.length,
+            x_unit: self.x_unit,
+            mirror: self.mirror,
         }
-        let samples = 4096;
-        (0..=samples)
-            .map(|i| self.length * i as f64 / samples as f64)
-            .map(|u| (u, self.density_at(u)))
-            .find(|&(_, d)| !d.is_finite() || !(0.0..=max).contains(&d))
+    }
+
+    /// Fit the pattern to its face, of unit normal `normal` (tag `tag`): `axis` must lie
+    /// in the face; `across`, when the file left it out, becomes `normal x axis`, else it
+    /// must lie in the face, perpendicular to `axis`.
+    pub fn fit_to_face(&mut self, ctx: &Ctx, tag: &str, normal: DVec3) -> Result<()> {
+        let n = normal;
+        if self.axis.dot(n).abs() > 1e-6 {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.axis"),
+                "must lie in the face (it is not perpendicular to the face normal)",
+            ));
+        }
+        if self.across == DVec3::ZERO {
+            self.across = n.cross(self.axis).normalize();
+        } else if self.across.dot(n).abs() > 1e-6 || self.across.dot(self.axis).abs() > 1e-6 {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.across"),
+                "must lie in the face, perpendicular to axis",
+            ));
+        }
+        Ok(())
     }
 
     /// Distance (mm) between lattice rows: the pitch for square cells, `pitch sqrt(3)/2`
@@ -494,6 +428,39 @@ mod tests {
                 );
                 let off = c + DVec2::new(0.1, 0.05) * p.pitch;
                 assert!(p.nearest_centre(off).distance(c) < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn agrees_with_the_dot_density_convention() {
+        for (x_unit, mirror) in [
+            (XUnit::Normalized, false),
+            (XUnit::Normalized, true),
+            (XUnit::Mm, false),
+            (XUnit::Mm, true),
+        ] {
+            let density = Density::Polynomial(vec![0.05, 0.2, -0.1, 0.03]);
+            let g = Gradation {
+                density: density.clone(),
+                length: 37.0,
+                x_unit,
+                mirror,
+            };
+            let d = DotPattern {
+                lattice: Lattice::Square,
+                pitch: 0.5,
+                origin: DVec3::ZERO,
+                axis: DVec3::X,
+                across: DVec3::Y,
+                length: 37.0,
+                density,
+                x_unit,
+                mirror,
+            };
+            for k in -3..=40 {
+                let u = k as f64;
+                assert_eq!(g.at(u), d.density_at(u), "{x_unit:?} {mirror} u={u}");
             }
         }
     }

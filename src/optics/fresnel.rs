@@ -3,7 +3,11 @@
 //! The paper's equation (3) writes R_s and R_p as ratios of sines and tangents, which is
 //! 0/0 at normal incidence. Here they are written with cosines (Born & Wolf), exact at
 //! every angle: normal, grazing and either side of the critical angle.
+//!
+//! [`roulette`] chooses between reflection and refraction by Russian roulette on R: every
+//! dielectric face (smooth, grooved, rough) uses it.
 
+use crate::rng::PhotonRng;
 use glam::DVec3;
 
 /// Unpolarized Fresnel reflectance `(R_s + R_p) / 2` for light going from index `n1`
@@ -52,6 +56,20 @@ pub fn refract(dir: DVec3, n: DVec3, n1: f64, n2: f64) -> Option<DVec3> {
     let cos_t = cos_transmitted(cos_i, n1, n2)?;
     let eta = n1 / n2;
     Some((eta * dir + (eta * cos_i - cos_t) * n).normalize())
+}
+
+/// The Fresnel roulette of unit `dir` meeting a surface of unit normal `facing` (facing
+/// the incident side, `dir · facing < 0`) from index `n1` into `n2`: reflected with
+/// probability R (always under total internal reflection), else refracted. `Some(t)`:
+/// refracted along `t`; `None`: reflected (the caller mirrors `dir` about `facing`).
+///
+/// One uniform is drawn, unless R = 1.
+pub fn roulette(dir: DVec3, facing: DVec3, n1: f64, n2: f64, rng: &mut PhotonRng) -> Option<DVec3> {
+    let r = reflectance(-dir.dot(facing), n1, n2);
+    if r >= 1.0 || rng.uniform() < r {
+        return None;
+    }
+    refract(dir, facing, n1, n2)
 }
 
 #[cfg(test)]

@@ -1,15 +1,24 @@
 //! Optical models: what happens to a photon where it meets a surface.
 //!
-//! One module per physical model: [`fresnel`] (dielectric interfaces), [`sampling`]
-//! (direction sampling for diffuse and Phong lobes), [`dots`] (procedural ink-dot
-//! patterns), [`grooves`] (procedural V-grooves and prism films, traced exactly in their
-//! layer), [`diffuser`] (rough diffusing faces), [`gradation`] (values graded along a
-//! guide) and [`surface`] (the per-tag model and its Russian roulette).
+//! One module per surface model, each with its scene-file entry, its checks and its
+//! physics: [`dielectric`] (smooth interfaces), [`dots`] (procedural ink-dot patterns),
+//! [`grooves`] (procedural V-grooves and prism films, traced exactly in their layer),
+//! [`diffuser`] (rough diffusing faces), [`phong`], [`lambert`], [`mirror`] and
+//! [`absorber`]; [`surface`] joins them into the per-tag model and its Russian roulette.
+//! Shared by several: [`medium`] (media and interfaces), [`fresnel`] (Fresnel equations
+//! and roulette), [`sampling`] (direction sampling) and [`density`] (values graded along
+//! a guide).
 
+pub mod absorber;
+pub mod density;
+pub mod dielectric;
 pub mod diffuser;
 pub mod dots;
 pub mod fresnel;
-pub mod gradation;
 pub mod grooves;
+pub mod lambert;
+pub mod medium;
+pub mod mirror;
+pub mod phong;
 pub mod sampling;
 pub mod surface;

@@ -35,8 +35,17 @@
 //! Sections `[surfaces.*]`, `[[sources]]`, `[detector]` and `[trace]` are documented in
 //! the modules that implement them.
 
-use crate::optics::dots::{Lattice, XUnit};
-use crate::optics::grooves::Relief;
+use crate::optics::absorber::AbsorberSpec;
+pub use crate::optics::density::DensityGridSpec;
+use crate::optics::dielectric::DielectricSpec;
+use crate::optics::diffuser::DiffuserSpec;
+use crate::optics::dots::DotsSpec;
+use crate::optics::grooves::GroovesSpec;
+use crate::optics::lambert::LambertSpec;
+pub use crate::optics::medium::MediumSpec;
+use crate::optics::medium::air;
+use crate::optics::mirror::MirrorSpec;
+use crate::optics::phong::PhongSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -88,156 +97,28 @@ fn one() -> f64 {
     1.0
 }
 
-/// A homogeneous medium.
+/// The optical model of one tag: `model = "..."` picks the model, whose module owns the
+/// rest of the entry and its checks.
 #[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct MediumSpec {
-    /// Refractive index.
-    pub n: f64,
-    /// Beer-Lambert absorption coefficient (1/mm).
-    #[serde(default)]
-    pub absorption_per_mm: f64,
-}
-
-fn air() -> String {
-    "air".into()
-}
-
-/// The optical model of one tag.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(tag = "model", rename_all = "lowercase", deny_unknown_fields)]
+#[serde(tag = "model", rename_all = "lowercase")]
 pub enum SurfaceSpec {
-    /// Smooth dielectric interface.
-    Dielectric {
-        /// Medium behind the face.
-        inside: String,
-        /// Medium in front of the face.
-        #[serde(default = "air")]
-        outside: String,
-    },
-    /// Dielectric interface with printed ink dots.
-    Dots {
-        /// Medium behind the face.
-        inside: String,
-        /// Medium in front of the face.
-        #[serde(default = "air")]
-        outside: String,
-        /// Ink albedo (Lambertian).
-        ink_albedo: f64,
-        /// Cell lattice.
-        lattice: Lattice,
-        /// Cell pitch (mm).
-        pitch_mm: f64,
-        /// A point on the lamp edge, in the face.
-        origin: [f64; 3],
-        /// Propagation direction.
-        axis: [f64; 3],
-        /// In-face direction across `axis` (default: face normal x axis, found at load).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        across: Option<[f64; 3]>,
-        /// Span along `axis` (mm).
-        length_mm: f64,
-        /// Density polynomial coefficients, lowest degree first (or `density_table`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        density: Option<Vec<f64>>,
-        /// Tabulated density: knots `[x, d]`, x increasing, linear between (or `density`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        density_table: Option<Vec<[f64; 2]>>,
-        /// Density on a grid of knots over the face, bilinear (or `density`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        density_grid: Option<DensityGridSpec>,
-        /// Unit of the polynomial variable.
-        #[serde(default)]
-        x_unit: XUnit,
-        /// Lamps on both edges: measure from the nearer.
-        #[serde(default)]
-        mirror: bool,
-    },
+    /// Smooth dielectric interface ([`crate::optics::dielectric`]).
+    Dielectric(DielectricSpec),
+    /// Dielectric interface with printed ink dots ([`crate::optics::dots`]).
+    Dots(DotsSpec),
     /// Dielectric interface carrying procedural V-grooves or prisms
     /// ([`crate::optics::grooves`]).
-    Grooves {
-        /// Medium behind the face.
-        inside: String,
-        /// Medium in front of the face.
-        #[serde(default = "air")]
-        outside: String,
-        /// Notches cut into `inside`, or prisms raised out of the face.
-        relief: Relief,
-        /// Angle between the two facets (deg), in (0, 180).
-        apex_deg: f64,
-        /// Tilt of the V (deg): the facet on the `-axis` side gets base angle
-        /// `90 - apex/2 + tilt`, the other `90 - apex/2 - tilt`.
-        #[serde(default)]
-        tilt_deg: f64,
-        /// Groove pitch (mm).
-        pitch_mm: f64,
-        /// A point on the lamp edge (where the first cell starts).
-        origin: [f64; 3],
-        /// In-face direction across the grooves (away from the lamp).
-        axis: [f64; 3],
-        /// Span along `axis` (mm); needed when the fill varies or is mirrored.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        length_mm: Option<f64>,
-        /// Fill fraction polynomial, lowest degree first (default `[1.0]`; or
-        /// `density_table`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        density: Option<Vec<f64>>,
-        /// Tabulated fill fraction: knots `[x, f]`, x increasing (or `density`).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        density_table: Option<Vec<[f64; 2]>>,
-        /// Unit of the polynomial variable.
-        #[serde(default)]
-        x_unit: XUnit,
-        /// Lamps on both edges: measure from the nearer.
-        #[serde(default)]
-        mirror: bool,
-    },
+    Grooves(GroovesSpec),
     /// Rough (diffusing) dielectric interface ([`crate::optics::diffuser`]).
-    Diffuser {
-        /// Medium behind the face.
-        inside: String,
-        /// Medium in front of the face.
-        #[serde(default = "air")]
-        outside: String,
-        /// GGX roughness alpha (0: smooth).
-        roughness: f64,
-    },
-    /// Phong reflector.
-    Phong {
-        /// Total reflectance.
-        reflectance: f64,
-        /// Specular fraction of the reflected energy.
-        specular: f64,
-        /// Phong exponent.
-        exponent: f64,
-    },
-    /// Lambertian scatterer.
-    Lambert {
-        /// Albedo.
-        albedo: f64,
-    },
-    /// Specular mirror.
-    Mirror {
-        /// Reflectance.
-        #[serde(default = "one")]
-        reflectance: f64,
-    },
-    /// Black absorber.
-    Absorber {},
-}
-
-/// `density_grid = { width_mm = W, values = [[...], ...] }` of a dots surface: rows across
-/// the axis (`v_min_mm ..= v_min_mm + width_mm`), columns along it (`x` over `0..=x_max`).
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct DensityGridSpec {
-    /// Span across the axis from the first to the last row (mm).
-    pub width_mm: f64,
-    /// Position of the first row across the axis (mm from the origin along `across`).
-    #[serde(default)]
-    pub v_min_mm: f64,
-    /// `values[j][i]`: row `j` across the axis, column `i` along it.
-    pub values: Vec<Vec<f64>>,
+    Diffuser(DiffuserSpec),
+    /// Phong reflector ([`crate::optics::phong`]).
+    Phong(PhongSpec),
+    /// Lambertian scatterer ([`crate::optics::lambert`]).
+    Lambert(LambertSpec),
+    /// Specular mirror ([`crate::optics::mirror`]).
+    Mirror(MirrorSpec),
+    /// Black absorber ([`crate::optics::absorber`]).
+    Absorber(AbsorberSpec),
 }
 
 /// A light source.

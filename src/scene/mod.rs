@@ -10,21 +10,20 @@
 
 pub mod config;
 pub mod meshio;
-mod relief;
 mod solids;
 
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};
-use crate::optics::dots::{Density, DensityGrid, DotPattern};
-use crate::optics::surface::{Interface, Medium, MediumId, Phong, SurfaceModel};
+use crate::optics::medium::{self, Medium, MediumId, medium_id};
+use crate::optics::surface::SurfaceModel;
 use crate::rng::PhotonRng;
 use crate::sources::intensity::IntensityProfile;
 use crate::sources::{Emitter, Source, Sources};
+use crate::spec_check::Ctx;
 use anyhow::{Context, Result};
 use config::{DetectorSpec, SceneFile, SourceSpec, SurfaceSpec};
 use glam::{DMat4, DVec3};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -63,62 +62,6 @@ pub struct Scene {
     pub convex: Vec<Option<ConvexSolid>>,
 }
 
-/// Names an error's place: file and field.
-struct Ctx<'a>(&'a Path);
-
-impl Ctx<'_> {
-    fn err(&self, field: &str, msg: impl std::fmt::Display) -> anyhow::Error {
-        anyhow::anyhow!("{}: {field}: {msg}", self.0.display())
-    }
-
-    fn finite(&self, field: &str, x: f64) -> Result<f64> {
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.err(field, format!("must be a finite number, got {x}")))
-        }
-    }
-
-    fn positive(&self, field: &str, x: f64) -> Result<f64> {
-        if self.finite(field, x)? > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.err(field, format!("must be > 0, got {x}")))
-        }
-    }
-
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
-        if self.finite(field, x)? >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.err(field, format!("must be >= 0, got {x}")))
-        }
-    }
-
-    fn fraction(&self, field: &str, x: f64) -> Result<f64> {
-        if (0.0..=1.0).contains(&self.finite(field, x)?) {
-            Ok(x)
-        } else {
-            Err(self.err(field, format!("must be within [0, 1], got {x}")))
-        }
-    }
-
-    fn point(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
-        for (i, c) in p.iter().enumerate() {
-            self.finite(&format!("{field}[{i}]"), *c)?;
-        }
-        Ok(DVec3::from_array(p))
-    }
-
-    fn direction(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
-        let v = self.point(field, p)?;
-        if v.length() < 1e-12 {
-            return Err(self.err(field, "must be a non-zero direction"));
-        }
-        Ok(v.normalize())
-    }
-}
-
 impl Scene {
     /// Load and validate the scene file at `path` and the geometry it names.
     pub fn load(path: &Path) -> Result<Scene> {
@@ -144,7 +87,7 @@ impl Scene {
             ));
         }
         let mut warnings = Vec::new();
-        let media = build_media(&ctx, &file.media)?;
+        let media = medium::build_media(&ctx, &file.media)?;
         let (mut mesh, tags) = load_geometry(&ctx, file, path, &mut warnings)?;
         let mut surfaces = Vec::with_capacity(tags.len());
         for tag in &tags {
@@ -160,8 +103,7 @@ impl Scene {
             ));
         }
         solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
-        finish_dot_patterns(&ctx, &mesh, &tags, &mut surfaces)?;
-        relief::finish_groove_patterns(&ctx, &mesh, &tags, &mut surfaces)?;
+        fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
         let sources = build_sources(&ctx, &file.sources, &media)?;
         let detector = build_detector(&ctx, &file.detector)?;
         if file.trace.max_bounces == 0 {
@@ -375,55 +317,6 @@ fn default_name(path: &Path) -> String {
         .unwrap_or_else(|| "scene".into())
 }
 
-fn build_media(ctx: &Ctx, specs: &BTreeMap<String, config::MediumSpec>) -> Result<Vec<Medium>> {
-    let mut media = vec![Medium {
-        name: "air".into(),
-        n: 1.0,
-        absorption_per_mm: 0.0,
-    }];
-    for (name, spec) in specs {
-        let n = ctx.positive(&format!("media.{name}.n"), spec.n)?;
-        let a = ctx.finite(
-            &format!("media.{name}.absorption_per_mm"),
-            spec.absorption_per_mm,
-        )?;
-        if a < 0.0 {
-            return Err(ctx.err(
-                &format!("media.{name}.absorption_per_mm"),
-                format!("must be >= 0, got {a}"),
-            ));
-        }
-        let m = Medium {
-            name: name.clone(),
-            n,
-            absorption_per_mm: a,
-        };
-        if name == "air" {
-            media[0] = m;
-        } else {
-            media.push(m);
-        }
-    }
-    if media.len() > MediumId::MAX as usize {
-        return Err(ctx.err("media", "too many media"));
-    }
-    Ok(media)
-}
-
-fn medium_id(ctx: &Ctx, field: &str, name: &str, media: &[Medium]) -> Result<MediumId> {
-    media
-        .iter()
-        .position(|m| m.name == name)
-        .map(|i| i as MediumId)
-        .ok_or_else(|| {
-            let known: Vec<&str> = media.iter().map(|m| m.name.as_str()).collect();
-            ctx.err(
-                field,
-                format!("unknown medium '{name}' (known: {})", known.join(", ")),
-            )
-        })
-}
-
 fn load_geometry(
     ctx: &Ctx,
     file: &SceneFile,
@@ -504,158 +397,74 @@ fn load_geometry(
     Ok((mesh, tags))
 }
 
-fn interface(
-    ctx: &Ctx,
-    tag: &str,
-    inside: &str,
-    outside: &str,
-    media: &[Medium],
-) -> Result<Interface> {
-    Ok(Interface {
-        inside: medium_id(ctx, &format!("surfaces.{tag}.inside"), inside, media)?,
-        outside: medium_id(ctx, &format!("surfaces.{tag}.outside"), outside, media)?,
-    })
-}
-
+/// Check a surface entry and build its model (each model checks its own fields).
 fn build_surface(
     ctx: &Ctx,
     tag: &str,
     spec: &SurfaceSpec,
     media: &[Medium],
 ) -> Result<SurfaceModel> {
-    let f = |k: &str| format!("surfaces.{tag}.{k}");
     Ok(match spec {
-        SurfaceSpec::Dielectric { inside, outside } => {
-            SurfaceModel::Dielectric(interface(ctx, tag, inside, outside, media)?)
-        }
-        SurfaceSpec::Dots {
-            inside,
-            outside,
-            ink_albedo,
-            lattice,
-            pitch_mm,
-            origin,
-            axis,
-            across,
-            length_mm,
-            density,
-            density_table,
-            density_grid,
-            x_unit,
-            mirror,
-        } => {
-            let (density, field) = match (density, density_table, density_grid) {
-                (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
-                (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
-                (None, None, Some(g)) => {
-                    let x_max =
-                        crate::optics::gradation::graded_x_max(*length_mm, *x_unit, *mirror);
-                    let grid = DensityGrid {
-                        x_max,
-                        v_min: g.v_min_mm,
-                        width: g.width_mm,
-                        values: g.values.clone(),
-                    };
-                    (Density::Grid(grid), f("density_grid"))
-                }
-                (Some(_), Some(_), _) | (Some(_), _, Some(_)) | (_, Some(_), Some(_)) => {
-                    return Err(ctx.err(
-                        &f("density"),
-                        "give only one of density (polynomial), density_table and density_grid",
-                    ));
-                }
-                (None, None, None) => {
-                    return Err(ctx.err(
-                        &f("density"),
-                        "missing: give density (polynomial coefficients), density_table ([x, d] knots) or density_grid",
-                    ));
-                }
-            };
-            if let Some(problem) = density.problem() {
-                return Err(ctx.err(&field, problem));
-            }
-            let pattern = DotPattern {
-                lattice: *lattice,
-                pitch: ctx.positive(&f("pitch_mm"), *pitch_mm)?,
-                origin: ctx.point(&f("origin"), *origin)?,
-                axis: ctx.direction(&f("axis"), *axis)?,
-                across: match across {
-                    Some(a) => ctx.direction(&f("across"), *a)?,
-                    None => DVec3::ZERO,
-                },
-                length: ctx.positive(&f("length_mm"), *length_mm)?,
-                density,
-                x_unit: *x_unit,
-                mirror: *mirror,
-            };
-            if let Some((u, d)) = pattern.first_out_of_range() {
-                return Err(ctx.err(&field, format!(
-                    "d(x) = {d:.4} at {u:.3} mm from the origin is outside [0, {:.4}] (the {:?} lattice's packing limit)",
-                    lattice.max_packing(), lattice
-                )));
-            }
+        SurfaceSpec::Dielectric(s) => SurfaceModel::Dielectric(s.build(ctx, tag, media)?),
+        SurfaceSpec::Dots(s) => {
+            let (interface, pattern, ink_albedo) = s.build(ctx, tag, media)?;
             SurfaceModel::Dots {
-                interface: interface(ctx, tag, inside, outside, media)?,
+                interface,
                 pattern,
-                ink_albedo: ctx.fraction(&f("ink_albedo"), *ink_albedo)?,
+                ink_albedo,
             }
         }
-        SurfaceSpec::Phong {
-            reflectance,
-            specular,
-            exponent,
-        } => SurfaceModel::Phong(Phong {
-            reflectance: ctx.fraction(&f("reflectance"), *reflectance)?,
-            specular: ctx.fraction(&f("specular"), *specular)?,
-            exponent: ctx.positive(&f("exponent"), *exponent)?,
-        }),
-        SurfaceSpec::Lambert { albedo } => SurfaceModel::Lambert {
-            albedo: ctx.fraction(&f("albedo"), *albedo)?,
-        },
-        SurfaceSpec::Mirror { reflectance } => SurfaceModel::Mirror {
-            reflectance: ctx.fraction(&f("reflectance"), *reflectance)?,
-        },
-        SurfaceSpec::Absorber {} => SurfaceModel::Absorber,
-        SurfaceSpec::Grooves { .. } | SurfaceSpec::Diffuser { .. } => {
-            relief::build(ctx, tag, spec, media)?.expect("grooves and diffuser are relief models")
+        SurfaceSpec::Grooves(s) => {
+            let (interface, pattern) = s.build(ctx, tag, media)?;
+            SurfaceModel::Grooves { interface, pattern }
         }
+        SurfaceSpec::Diffuser(s) => {
+            let (interface, roughness) = s.build(ctx, tag, media)?;
+            SurfaceModel::Diffuser {
+                interface,
+                roughness,
+            }
+        }
+        SurfaceSpec::Phong(s) => SurfaceModel::Phong(s.build(ctx, tag)?),
+        SurfaceSpec::Lambert(s) => SurfaceModel::Lambert {
+            albedo: s.build(ctx, tag)?,
+        },
+        SurfaceSpec::Mirror(s) => SurfaceModel::Mirror {
+            reflectance: s.build(ctx, tag)?,
+        },
+        SurfaceSpec::Absorber(_) => SurfaceModel::Absorber,
     })
 }
 
-/// Fill in each dot pattern's `across` direction from its face and check its axis lies in
-/// the face.
-fn finish_dot_patterns(
+/// Fit each dot and groove pattern to its face (see [`DotPattern::fit_to_face`] and
+/// [`GroovePattern::fit_to_face`]); runs after the faces are oriented.
+///
+/// [`DotPattern::fit_to_face`]: crate::optics::dots::DotPattern::fit_to_face
+/// [`GroovePattern::fit_to_face`]: crate::optics::grooves::GroovePattern::fit_to_face
+fn fit_patterns_to_faces(
     ctx: &Ctx,
     mesh: &Mesh,
     tags: &[String],
     surfaces: &mut [SurfaceModel],
 ) -> Result<()> {
-    for (tag_id, s) in surfaces.iter_mut().enumerate() {
-        let SurfaceModel::Dots { pattern, .. } = s else {
-            continue;
-        };
-        let tag = &tags[tag_id];
-        let prim = mesh
-            .tri_tag
+    let normals = |tag_id: usize| {
+        mesh.tri_tag
             .iter()
-            .position(|&t| t as usize == tag_id)
-            .expect("used tag has triangles");
-        let n = mesh.normal(prim as u32);
-        if pattern.axis.dot(n).abs() > 1e-6 {
-            return Err(ctx.err(
-                &format!("surfaces.{tag}.axis"),
-                "must lie in the face (it is not perpendicular to the face normal)",
-            ));
+            .enumerate()
+            .filter(move |(_, t)| **t as usize == tag_id)
+            .map(|(p, _)| mesh.normal(p as u32))
+    };
+    // All dots first, then all grooves: which error comes first does not depend on the
+    // order of the tags.
+    for (tag_id, s) in surfaces.iter_mut().enumerate() {
+        if let SurfaceModel::Dots { pattern, .. } = s {
+            let n = normals(tag_id).next().expect("used tag has triangles");
+            pattern.fit_to_face(ctx, &tags[tag_id], n)?;
         }
-        if pattern.across == DVec3::ZERO {
-            pattern.across = n.cross(pattern.axis).normalize();
-        } else if pattern.across.dot(n).abs() > 1e-6
-            || pattern.across.dot(pattern.axis).abs() > 1e-6
-        {
-            return Err(ctx.err(
-                &format!("surfaces.{tag}.across"),
-                "must lie in the face, perpendicular to axis",
-            ));
+    }
+    for (tag_id, s) in surfaces.iter_mut().enumerate() {
+        if let SurfaceModel::Grooves { pattern, .. } = s {
+            pattern.fit_to_face(ctx, &tags[tag_id], normals(tag_id))?;
         }
     }
     Ok(())
@@ -681,7 +490,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
             } => Source {
                 name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
                 power_w: ctx.positive(&f("power_w"), *power_w)?,
-                lumens: optional_positive(ctx, &f("lumens"), *lumens)?,
+                lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
                 emitter: Emitter::Ccfl {
                     center: ctx.point(&f("center"), *center)?,
                     axis: ctx.direction(&f("axis"), *axis)?,
@@ -716,7 +525,7 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
                 Source {
                     name: name.clone().unwrap_or_else(|| format!("led{i}")),
                     power_w: ctx.positive(&f("power_w"), *power_w)?,
-                    lumens: optional_positive(ctx, &f("lumens"), *lumens)?,
+                    lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
                     emitter: match (intensity_file, cos_exponent) {
                         (Some(_), Some(_)) => {
                             return Err(ctx.err(
@@ -752,10 +561,6 @@ fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<So
         });
     }
     Ok(Sources::new(list))
-}
-
-fn optional_positive(ctx: &Ctx, field: &str, x: Option<f64>) -> Result<Option<f64>> {
-    x.map(|v| ctx.positive(field, v)).transpose()
 }
 
 fn build_detector(ctx: &Ctx, d: &DetectorSpec) -> Result<TargetPlane> {

@@ -2,9 +2,10 @@
 //! consistently wound surface, or photons would leak through the gaps. Faces are
 //! re-wound so normals point out of the medium they enclose.
 
-use super::Ctx;
 use crate::geometry::Mesh;
-use crate::optics::surface::{Medium, SurfaceModel};
+use crate::optics::medium::Medium;
+use crate::optics::surface::SurfaceModel;
+use crate::spec_check::Ctx;
 use anyhow::Result;
 use std::collections::{HashMap, VecDeque};
 

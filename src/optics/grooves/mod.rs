@@ -78,8 +78,12 @@
 //! 4.5 standard errors at 2 million photons: the border effect above, which scales with
 //! `H` over the plate's length.
 
+mod spec;
+
+pub use spec::GroovesSpec;
+
+use super::density::Gradation;
 use super::fresnel;
-use super::gradation::Gradation;
 use crate::rng::PhotonRng;
 use glam::DVec3;
 
@@ -139,7 +143,7 @@ struct Crossing {
 
 impl GroovePattern {
     /// A pattern with its derived depth; angles in radians. The caller has checked the
-    /// parameters (see `scene::build_surface`).
+    /// parameters (see [`GroovesSpec::build`]).
     pub fn new(
         relief: Relief,
         pitch: f64,
@@ -380,14 +384,12 @@ impl GroovePattern {
             } else {
                 (n_outside, n_inside, m)
             };
-            let r = fresnel::reflectance(-d.dot(facing), n1, n2);
-            if r >= 1.0 || rng.uniform() < r {
-                d = fresnel::reflect(d, facing).normalize();
-            } else if let Some(t) = fresnel::refract(d, facing, n1, n2) {
-                d = t;
-                inside = !inside;
-            } else {
-                d = fresnel::reflect(d, facing).normalize();
+            match fresnel::roulette(d, facing, n1, n2, rng) {
+                Some(t) => {
+                    d = t;
+                    inside = !inside;
+                }
+                None => d = fresnel::reflect(d, facing).normalize(),
             }
         }
         None
@@ -397,7 +399,7 @@ impl GroovePattern {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optics::dots::XUnit;
+    use crate::optics::density::{Density, XUnit};
 
     fn pattern(relief: Relief, apex_deg: f64, tilt_deg: f64, fill: Gradation) -> GroovePattern {
         GroovePattern::new(
@@ -413,7 +415,7 @@ mod tests {
     #[test]
     fn grooves_take_the_fill_fraction_and_depth_of_their_cell() {
         let fill = Gradation {
-            density: crate::optics::dots::Density::Polynomial(vec![0.1, 0.8]),
+            density: Density::Polynomial(vec![0.1, 0.8]),
             length: 10.0,
             x_unit: XUnit::Normalized,
             mirror: false,
@@ -612,7 +614,7 @@ mod tests {
         // Graded asymmetric grooves, both reliefs, both face orientations, rays from every
         // direction: the same random numbers give the same photon, event for event.
         let fill = Gradation {
-            density: crate::optics::dots::Density::Polynomial(vec![0.1, 0.4]),
+            density: Density::Polynomial(vec![0.1, 0.4]),
             length: 20.0,
             x_unit: XUnit::Normalized,
             mirror: false,

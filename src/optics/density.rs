@@ -1,0 +1,363 @@
+//! A quantity graded along a light guide: the dot density of [`super::dots`] and the
+//! groove fill fraction of [`super::grooves`].
+//!
+//! The value is a [`Density`] function of `x`, the distance from the lamp edge along the
+//! pattern's axis, either in millimetres or normalized by the span (`x_unit`), measured
+//! from the nearer edge when lamps sit at both ends (`mirror`): a polynomial, a table of
+//! knots, or (dots only) a grid of knots over the face that also varies across the axis.
+//!
+//! ```toml
+//! density = [0.05, 0.0, 0.0, 0.0]   # d(x) = c0 + c1 x + c2 x^2 + c3 x^3
+//! # density_table = [[0.0, 0.02], [0.5, 0.2], [1.0, 0.6]]   # [x, d] knots, linear
+//! # density_grid = { width_mm = 68.0, values = [[0.02, 0.1], [0.03, 0.12]] }   # dots
+//! x_unit = "normalized"   # x in [0, 1] ("mm": x in millimetres)
+//! mirror = true           # lamps on both edges: x measured from the nearer edge
+//! ```
+//!
+//! Dots and grooves measure `x` with the same [`graded_x`] and check the range of their
+//! value with the same [`Gradation::first_outside`].
+
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+
+/// How the polynomial's variable is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum XUnit {
+    /// Distance divided by the span from the lamp edge to the far edge (or to the centre
+    /// line when mirrored): x in `[0, 1]`.
+    #[default]
+    Normalized,
+    /// Distance in millimetres.
+    Mm,
+}
+
+/// The density function d(x): the area fraction of a cell covered by its dot.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Density {
+    /// Polynomial coefficients, lowest degree first: `d(x) = c0 + c1 x + c2 x^2 + ...`.
+    Polynomial(Vec<f64>),
+    /// Knots `[x, d]`, `x` strictly increasing: linear between knots, constant beyond
+    /// the first and the last.
+    Table(Vec<[f64; 2]>),
+    /// Knots on a regular grid over the face (along the axis and across it), bilinear.
+    Grid(DensityGrid),
+}
+
+/// A density on a regular grid of knots: along the axis in the polynomial variable
+/// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DensityGrid {
+    /// The polynomial variable at the last column of knots.
+    pub x_max: f64,
+    /// Position across the axis (mm from the origin along `across`) of the first row.
+    pub v_min: f64,
+    /// Span across the axis (mm) from the first to the last row.
+    pub width: f64,
+    /// `values[j][i]`: row `j` across the axis, column `i` along it.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// `density_grid = { width_mm = W, values = [[...], ...] }` of a dots surface: rows across
+/// the axis (`v_min_mm ..= v_min_mm + width_mm`), columns along it (`x` over `0..=x_max`).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DensityGridSpec {
+    /// Span across the axis from the first to the last row (mm).
+    pub width_mm: f64,
+    /// Position of the first row across the axis (mm from the origin along `across`).
+    #[serde(default)]
+    pub v_min_mm: f64,
+    /// `values[j][i]`: row `j` across the axis, column `i` along it.
+    pub values: Vec<Vec<f64>>,
+}
+
+impl DensityGridSpec {
+    /// The grid, its last column at the polynomial variable `x_max` (see [`graded_x_max`]).
+    pub fn grid(&self, x_max: f64) -> DensityGrid {
+        DensityGrid {
+            x_max,
+            v_min: self.v_min_mm,
+            width: self.width_mm,
+            values: self.values.clone(),
+        }
+    }
+}
+
+impl DensityGrid {
+    /// Columns (knots along the axis) and rows (across it).
+    pub fn shape(&self) -> (usize, usize) {
+        (self.values.first().map_or(0, Vec::len), self.values.len())
+    }
+
+    /// Fractional knot coordinates of `(x, v)`, clamped to the grid.
+    fn knot_coords(&self, x: f64, v: f64) -> (f64, f64) {
+        let (nx, ny) = self.shape();
+        let fx = if nx > 1 && self.x_max > 0.0 {
+            (x / self.x_max * (nx - 1) as f64).clamp(0.0, (nx - 1) as f64)
+        } else {
+            0.0
+        };
+        let fy = if ny > 1 && self.width > 0.0 {
+            ((v - self.v_min) / self.width * (ny - 1) as f64).clamp(0.0, (ny - 1) as f64)
+        } else {
+            0.0
+        };
+        (fx, fy)
+    }
+
+    /// The knot nearest to `(x, v)`: (column, row).
+    pub fn nearest_knot(&self, x: f64, v: f64) -> (usize, usize) {
+        let (fx, fy) = self.knot_coords(x, v);
+        (fx.round() as usize, fy.round() as usize)
+    }
+
+    /// Bilinear interpolation at `(x, v)`, constant beyond the grid.
+    pub fn at(&self, x: f64, v: f64) -> f64 {
+        let (nx, ny) = self.shape();
+        if nx == 0 || ny == 0 {
+            return 0.0;
+        }
+        let (fx, fy) = self.knot_coords(x, v);
+        let (i0, j0) = (
+            (fx.floor() as usize).min(nx - 1),
+            (fy.floor() as usize).min(ny - 1),
+        );
+        let (i1, j1) = ((i0 + 1).min(nx - 1), (j0 + 1).min(ny - 1));
+        let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+        let g = |i: usize, j: usize| self.values[j][i];
+        let a = g(i0, j0) + (g(i1, j0) - g(i0, j0)) * tx;
+        let b = g(i0, j1) + (g(i1, j1) - g(i0, j1)) * tx;
+        a + (b - a) * ty
+    }
+
+    /// The mean over the rows at `x` (the density averaged across the axis).
+    pub fn row_mean(&self, x: f64) -> f64 {
+        let (_, ny) = self.shape();
+        if ny == 0 {
+            return 0.0;
+        }
+        (0..ny)
+            .map(|j| {
+                let v = self.v_min + self.width * j as f64 / (ny - 1).max(1) as f64;
+                self.at(x, v)
+            })
+            .sum::<f64>()
+            / ny as f64
+    }
+}
+
+impl Density {
+    /// The density at the polynomial variable `x` and `v` mm across the axis: a grid
+    /// uses both, the other densities only `x`.
+    pub fn at(&self, x: f64, v: f64) -> f64 {
+        match self {
+            Density::Grid(g) => g.at(x, v),
+            other => other.eval(x),
+        }
+    }
+
+    /// The density at the polynomial variable `x` (a grid's mean across the axis).
+    pub fn eval(&self, x: f64) -> f64 {
+        match self {
+            Density::Polynomial(c) => c.iter().rev().fold(0.0, |acc, c| acc * x + c),
+            Density::Table(knots) => interpolate(knots, x),
+            Density::Grid(g) => g.row_mean(x),
+        }
+    }
+
+    /// This density, if usable (see [`Density::problem`]); else an error at `field`.
+    pub fn checked(self, ctx: &Ctx, field: &str) -> Result<Density> {
+        match self.problem() {
+            Some(problem) => Err(ctx.err(field, problem)),
+            None => Ok(self),
+        }
+    }
+
+    /// Why this density cannot be used (empty, non-finite, knots not increasing), if so.
+    pub fn problem(&self) -> Option<String> {
+        match self {
+            Density::Polynomial(c) if c.is_empty() => Some("needs at least one coefficient".into()),
+            Density::Polynomial(c) => c
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|i| format!("coefficient {i} is not a finite number")),
+            Density::Table(k) if k.is_empty() => Some("needs at least one knot".into()),
+            Density::Table(k) => {
+                if let Some(i) = k
+                    .iter()
+                    .position(|p| !p[0].is_finite() || !p[1].is_finite())
+                {
+                    return Some(format!("knot {i} is not a pair of finite numbers"));
+                }
+                k.windows(2).position(|w| w[1][0] <= w[0][0]).map(|i| {
+                    format!(
+                        "knot x values must increase strictly (knots {i} and {})",
+                        i + 1
+                    )
+                })
+            }
+            Density::Grid(g) => {
+                let (nx, ny) = g.shape();
+                if nx == 0 || ny == 0 {
+                    return Some("needs at least one row of values".into());
+                }
+                if let Some(j) = g.values.iter().position(|r| r.len() != nx) {
+                    return Some(format!(
+                        "values must be rectangular: row {j} has {} values, row 0 has {nx}",
+                        g.values[j].len()
+                    ));
+                }
+                // One row needs no span across; more rows need a positive one.
+                if !(g.width.is_finite() && (g.width > 0.0 || (ny == 1 && g.width == 0.0))) {
+                    return Some(format!("width_mm must be positive, got {}", g.width));
+                }
+                if !g.v_min.is_finite() {
+                    return Some("v_min_mm is not a finite number".into());
+                }
+                for (j, r) in g.values.iter().enumerate() {
+                    if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+                        return Some(format!("values[{j}][{i}] is not a finite number"));
+                    }
+                }
+                None
+            }
+        }
+    }
+}
+
+/// Piecewise-linear interpolation through `knots` (x increasing), constant outside.
+fn interpolate(knots: &[[f64; 2]], x: f64) -> f64 {
+    let Some(first) = knots.first() else {
+        return 0.0;
+    };
+    let last = knots[knots.len() - 1];
+    if x <= first[0] {
+        return first[1];
+    }
+    if x >= last[0] {
+        return last[1];
+    }
+    // First knot strictly right of x; exists and is > 0 because first[0] < x < last[0].
+    let i = knots.partition_point(|k| k[0] <= x);
+    let (a, b) = (knots[i - 1], knots[i]);
+    a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0])
+}
+
+/// The grading variable at distance `u` (mm) from the lamp edge along a span of `length`
+/// (mm): clamped to the span, from the nearer edge when `mirror`, in mm or normalized by
+/// the span (the half span when mirrored).
+pub fn graded_x(u: f64, length: f64, unit: XUnit, mirror: bool) -> f64 {
+    let u = u.clamp(0.0, length);
+    let (dist, span) = if mirror {
+        (u.min(length - u), 0.5 * length)
+    } else {
+        (u, length)
+    };
+    match unit {
+        XUnit::Normalized => dist / span,
+        XUnit::Mm => dist,
+    }
+}
+
+/// The grading variable at the far end of a span of `length` (mm): 1 when normalized,
+/// else the span in mm (the length, or half of it when `mirror`).
+pub fn graded_x_max(length: f64, unit: XUnit, mirror: bool) -> f64 {
+    let end = if mirror { 0.5 * length } else { length };
+    graded_x(end, length, unit, mirror)
+}
+
+/// A function graded along an axis of span `length` (mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gradation {
+    /// The function of the variable `x`.
+    pub density: Density,
+    /// Span along the axis from the lamp edge to the far edge (mm).
+    pub length: f64,
+    /// Unit of the polynomial variable.
+    pub x_unit: XUnit,
+    /// Measure from the nearer of the two edges (lamps on both ends).
+    pub mirror: bool,
+}
+
+impl Gradation {
+    /// A constant value (no grading).
+    pub fn constant(value: f64) -> Self {
+        Self {
+            density: Density::Polynomial(vec![value]),
+            length: 1.0,
+            x_unit: XUnit::Mm,
+            mirror: false,
+        }
+    }
+
+    /// True when the value does not depend on position.
+    pub fn is_constant(&self) -> bool {
+        match &self.density {
+            Density::Polynomial(c) => c.iter().skip(1).all(|&c| c == 0.0),
+            Density::Table(k) => k.iter().all(|p| p[1] == k[0][1]),
+            Density::Grid(g) => g.values.iter().flatten().all(|v| *v == g.values[0][0]),
+        }
+    }
+
+    /// The polynomial variable at distance `u` (mm) along the axis from the lamp edge
+    /// (clamped to the span).
+    pub fn x_of(&self, u: f64) -> f64 {
+        graded_x(u, self.length, self.x_unit, self.mirror)
+    }
+
+    /// The graded value at distance `u` (mm) along the axis.
+    pub fn at(&self, u: f64) -> f64 {
+        self.density.eval(self.x_of(u))
+    }
+
+    /// The first position (mm) along the span where the value is not finite or outside
+    /// `[lo, hi]`, with that value: the knots of a grid (bilinear values lie between
+    /// them), else the value sampled finely along the span.
+    pub fn first_outside(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        let outside = |v: f64| !v.is_finite() || !(lo..=hi).contains(&v);
+        if let Density::Grid(g) = &self.density {
+            let (nx, _) = g.shape();
+            return g.values.iter().flatten().enumerate().find_map(|(k, &d)| {
+                let i = k % nx.max(1);
+                let u = self.length * i as f64 / (nx - 1).max(1) as f64;
+                let u = if self.mirror { 0.5 * u } else { u };
+                outside(d).then_some((u, d))
+            });
+        }
+        let samples = if self.is_constant() { 0 } else { 4096 };
+        (0..=samples)
+            .map(|i| self.length * i as f64 / samples.max(1) as f64)
+            .map(|u| (u, self.at(u)))
+            .find(|&(_, g)| outside(g))
+    }
+
+    /// Largest value over the span (sampled as [`Gradation::first_outside`] does).
+    pub fn max_over_span(&self) -> f64 {
+        let samples = if self.is_constant() { 0 } else { 4096 };
+        (0..=samples)
+            .map(|i| self.at(self.length * i as f64 / samples.max(1) as f64))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn range_checks_find_the_bad_spot() {
+        let g = Gradation {
+            density: Density::Polynomial(vec![0.2, 1.0]),
+            length: 10.0,
+            x_unit: XUnit::Normalized,
+            mirror: false,
+        };
+        let (u, v) = g.first_outside(0.0, 1.0).unwrap();
+        assert!(u > 7.9 && u < 8.1 && v > 1.0, "u={u} v={v}");
+        assert!((g.max_over_span() - 1.2).abs() < 1e-12);
+        assert_eq!(Gradation::constant(0.5).first_outside(0.0, 1.0), None);
+        assert!(Gradation::constant(-0.1).first_outside(0.0, 1.0).is_some());
+    }
+}

@@ -1,0 +1,57 @@
+//! Smooth dielectric interfaces: Fresnel reflection, Snell refraction and total internal
+//! reflection between two media.
+//!
+//! ```toml
+//! [surfaces.lgp]               # a tag used by the geometry files
+//! model = "dielectric"
+//! inside = "pmma"              # medium the face normal points away from
+//! outside = "air"              # default "air" (n = 1)
+//! ```
+
+use super::fresnel;
+use super::medium::{Interface, Medium, MediumId, air};
+use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// `[surfaces.TAG]` with `model = "dielectric"`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DielectricSpec {
+    /// Medium behind the face.
+    pub inside: String,
+    /// Medium in front of the face.
+    #[serde(default = "air")]
+    pub outside: String,
+}
+
+impl DielectricSpec {
+    /// Check `[surfaces.TAG]`: its media.
+    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<Interface> {
+        Interface::build(ctx, tag, &self.inside, &self.outside, media)
+    }
+}
+
+/// Fresnel roulette at a smooth interface with outward unit `normal`: the photon's new
+/// direction and the medium it now travels in.
+pub fn scatter(
+    media: &[Medium],
+    iface: &Interface,
+    normal: DVec3,
+    dir: DVec3,
+    rng: &mut PhotonRng,
+) -> (DVec3, MediumId) {
+    let entering = dir.dot(normal) < 0.0;
+    let (from, to, facing) = if entering {
+        (iface.outside, iface.inside, normal)
+    } else {
+        (iface.inside, iface.outside, -normal)
+    };
+    let (n1, n2) = (media[from as usize].n, media[to as usize].n);
+    match fresnel::roulette(dir, facing, n1, n2, rng) {
+        Some(t) => (t, to),
+        None => (fresnel::reflect(dir, facing), from),
+    }
+}

@@ -1,0 +1,164 @@
+//! The `grooves` entry of the scene file and its checks (the format is shown in
+//! [`super`]).
+
+use super::{GroovePattern, Relief};
+use crate::optics::density::{Density, Gradation, XUnit};
+use crate::optics::medium::{Interface, Medium, air};
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// `[surfaces.TAG]` with `model = "grooves"`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroovesSpec {
+    /// Medium behind the face.
+    pub inside: String,
+    /// Medium in front of the face.
+    #[serde(default = "air")]
+    pub outside: String,
+    /// Notches cut into `inside`, or prisms raised out of the face.
+    pub relief: Relief,
+    /// Angle between the two facets (deg), in (0, 180).
+    pub apex_deg: f64,
+    /// Tilt of the V (deg): the facet on the `-axis` side gets base angle
+    /// `90 - apex/2 + tilt`, the other `90 - apex/2 - tilt`.
+    #[serde(default)]
+    pub tilt_deg: f64,
+    /// Groove pitch (mm).
+    pub pitch_mm: f64,
+    /// A point on the lamp edge (where the first cell starts).
+    pub origin: [f64; 3],
+    /// In-face direction across the grooves (away from the lamp).
+    pub axis: [f64; 3],
+    /// Span along `axis` (mm); needed when the fill varies or is mirrored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length_mm: Option<f64>,
+    /// Fill fraction polynomial, lowest degree first (default `[1.0]`; or
+    /// `density_table`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<Vec<f64>>,
+    /// Tabulated fill fraction: knots `[x, f]`, x increasing (or `density`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_table: Option<Vec<[f64; 2]>>,
+    /// Unit of the polynomial variable.
+    #[serde(default)]
+    pub x_unit: XUnit,
+    /// Lamps on both edges: measure from the nearer.
+    #[serde(default)]
+    pub mirror: bool,
+}
+
+impl GroovesSpec {
+    /// Check `[surfaces.TAG]` and build its model: the interface and the groove layout
+    /// (its axis still to be fitted to the face, see [`GroovePattern::fit_to_face`]).
+    pub fn build(
+        &self,
+        ctx: &Ctx,
+        tag: &str,
+        media: &[Medium],
+    ) -> Result<(Interface, GroovePattern)> {
+        let f = |k: &str| format!("surfaces.{tag}.{k}");
+        let pitch = ctx.positive(&f("pitch_mm"), self.pitch_mm)?;
+        let apex = ctx.finite(&f("apex_deg"), self.apex_deg)?;
+        if !(apex > 0.0 && apex < 180.0) {
+            return Err(ctx.err(
+                &f("apex_deg"),
+                format!("must be within (0, 180) degrees, got {apex}"),
+            ));
+        }
+        let tilt = ctx.finite(&f("tilt_deg"), self.tilt_deg)?;
+        let limit = (0.5 * apex).min(90.0 - 0.5 * apex);
+        if tilt.abs() >= limit {
+            return Err(ctx.err(
+                &f("tilt_deg"),
+                format!(
+                    "must be within (-{limit}, {limit}) for apex_deg = {apex}, got {tilt}: both facets must lean \
+                     away from the apex (base angles 90 - apex/2 +- tilt within (0, 90) degrees)"
+                ),
+            ));
+        }
+        let (fill, field) = match (&self.density, &self.density_table) {
+            (Some(c), None) => (Density::Polynomial(c.clone()), f("density")),
+            (None, Some(k)) => (Density::Table(k.clone()), f("density_table")),
+            (None, None) => (Density::Polynomial(vec![1.0]), f("density")),
+            (Some(_), Some(_)) => {
+                return Err(ctx.err(
+                    &f("density"),
+                    "give either density (polynomial) or density_table, not both",
+                ));
+            }
+        };
+        let mut gradation = Gradation {
+            density: fill.checked(ctx, &field)?,
+            length: 1.0,
+            x_unit: self.x_unit,
+            mirror: self.mirror,
+        };
+        match self.length_mm {
+            Some(l) => gradation.length = ctx.positive(&f("length_mm"), l)?,
+            None if !gradation.is_constant() || self.mirror => {
+                return Err(ctx.err(
+                    &f("length_mm"),
+                    "missing: needed when the fill varies along axis or mirror = true",
+                ));
+            }
+            None => {}
+        }
+        if let Some((u, v)) = gradation.first_outside(0.0, 1.0) {
+            return Err(ctx.err(
+                &field,
+                format!(
+                    "fill f(x) = {v:.4} at {u:.3} mm from the origin is outside [0, 1] \
+                     (the fraction of each pitch taken by its groove)"
+                ),
+            ));
+        }
+        let angles = GroovePattern::base_angles(apex.to_radians(), tilt.to_radians());
+        Ok((
+            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
+            GroovePattern::new(
+                self.relief,
+                pitch,
+                angles,
+                ctx.point(&f("origin"), self.origin)?,
+                ctx.direction(&f("axis"), self.axis)?,
+                gradation,
+            ),
+        ))
+    }
+}
+
+impl GroovePattern {
+    /// Fit the pattern to its face, given the unit normals of the tag's triangles: the
+    /// face must be flat with `axis` in it (the profile is traced in the plane of `axis`
+    /// and the face normal); `axis` is made exactly perpendicular to the face normal.
+    /// Runs after the faces are oriented.
+    pub fn fit_to_face(
+        &mut self,
+        ctx: &Ctx,
+        tag: &str,
+        normals: impl IntoIterator<Item = DVec3>,
+    ) -> Result<()> {
+        let mut normal = None;
+        for n in normals {
+            let first = *normal.get_or_insert(n);
+            if n.dot(first).abs() < 1.0 - 1e-9 {
+                return Err(ctx.err(
+                    &format!("surfaces.{tag}"),
+                    "model grooves needs flat faces: the tag's triangles are not all parallel",
+                ));
+            }
+        }
+        let Some(n) = normal else { return Ok(()) };
+        if self.axis.dot(n).abs() > 1e-6 {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.axis"),
+                "must lie in the face (it is not perpendicular to the face normal)",
+            ));
+        }
+        self.axis = (self.axis - n * self.axis.dot(n)).normalize();
+        Ok(())
+    }
+}

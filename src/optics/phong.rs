@@ -1,0 +1,69 @@
+//! Phong reflectors: lamp reflectors and reflector sheets.
+//!
+//! ```toml
+//! [surfaces.lamp_reflector]
+//! model = "phong"              # reflectance, specular fraction, cos^exponent lobe
+//! reflectance = 0.95
+//! specular = 0.8
+//! exponent = 100.0
+//! ```
+//!
+//! Of the light it reflects (the fraction `reflectance`), the fraction `specular` goes
+//! into a `cos^exponent` lobe about the mirror direction and the rest is Lambertian.
+
+use super::{fresnel, lambert, sampling};
+use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// `[surfaces.TAG]` with `model = "phong"`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhongSpec {
+    /// Total reflectance.
+    pub reflectance: f64,
+    /// Specular fraction of the reflected energy.
+    pub specular: f64,
+    /// Phong exponent.
+    pub exponent: f64,
+}
+
+/// A Phong reflector (lamp reflector, reflector sheet).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phong {
+    /// Total reflectance (diffuse + specular).
+    pub reflectance: f64,
+    /// Fraction of the reflected energy in the specular lobe.
+    pub specular: f64,
+    /// Phong exponent of the specular lobe.
+    pub exponent: f64,
+}
+
+impl PhongSpec {
+    /// Check `[surfaces.TAG]` and build its model.
+    pub fn build(&self, ctx: &Ctx, tag: &str) -> Result<Phong> {
+        let f = |k: &str| format!("surfaces.{tag}.{k}");
+        Ok(Phong {
+            reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?,
+            specular: ctx.fraction(&f("specular"), self.specular)?,
+            exponent: ctx.positive(&f("exponent"), self.exponent)?,
+        })
+    }
+}
+
+impl Phong {
+    /// A reflected direction from the Phong BRDF, given that the photon arriving along
+    /// `dir` is reflected (`facing`: the unit normal on its side): diffuse with
+    /// probability `1 - specular`, else in the cos^n lobe around the mirror direction. A
+    /// lobe direction below the surface carries no BRDF value: `None` (absorbed there).
+    pub fn direction(&self, facing: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Option<DVec3> {
+        if rng.uniform() >= self.specular {
+            return Some(lambert::direction(facing, rng));
+        }
+        let mirror = fresnel::reflect(dir, facing);
+        let out = sampling::cos_power(mirror, self.exponent, rng.uniform(), rng.uniform());
+        (out.dot(facing) > 0.0).then_some(out)
+    }
+}

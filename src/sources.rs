@@ -30,13 +30,163 @@ pub mod body;
 pub mod intensity;
 
 use crate::geometry::{Ray, orthonormal_basis};
+use crate::optics::medium::{Medium, MediumId, air, medium_id};
 use crate::optics::sampling;
-use crate::optics::surface::MediumId;
 use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
 use glam::DVec3;
 use intensity::IntensityProfile;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// `[[sources]]`: a light source in the scene file.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum SourceSpec {
+    /// Cold-cathode fluorescent lamp: a Lambertian cylinder.
+    Ccfl {
+        /// Name for reports.
+        name: Option<String>,
+        /// Centre of the tube.
+        center: [f64; 3],
+        /// Tube axis.
+        axis: [f64; 3],
+        /// Radius (mm).
+        radius_mm: f64,
+        /// Length (mm).
+        length_mm: f64,
+        /// Radiant power (W).
+        power_w: f64,
+        /// Luminous flux (lm), for luminance outputs.
+        lumens: Option<f64>,
+        /// Medium around the tube.
+        #[serde(default = "air")]
+        medium: String,
+    },
+    /// Flat LED emitter.
+    Led {
+        /// Name for reports.
+        name: Option<String>,
+        /// Centre of the emitting rectangle.
+        center: [f64; 3],
+        /// Emitting normal.
+        normal: [f64; 3],
+        /// Width direction.
+        u: [f64; 3],
+        /// Width (mm).
+        width_mm: f64,
+        /// Height (mm).
+        height_mm: f64,
+        /// Radiant power (W).
+        power_w: f64,
+        /// Luminous flux (lm), for luminance outputs.
+        lumens: Option<f64>,
+        /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere); default 1.
+        /// Not with `intensity_file`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cos_exponent: Option<f64>,
+        /// Measured intensity table, `.csv` or `.ies` (relative to the scene file); see
+        /// [`crate::sources::intensity`].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        intensity_file: Option<PathBuf>,
+        /// Medium in front of the emitter.
+        #[serde(default = "air")]
+        medium: String,
+    },
+}
+
+impl SourceSpec {
+    /// Check entry `i` of `[[sources]]` and build the source (a measured LED's
+    /// `intensity_file` is relative to the scene file).
+    pub fn build(&self, ctx: &Ctx, i: usize, media: &[Medium]) -> Result<Source> {
+        let f = |k: &str| format!("sources[{i}].{k}");
+        Ok(match self {
+            SourceSpec::Ccfl {
+                name,
+                center,
+                axis,
+                radius_mm,
+                length_mm,
+                power_w,
+                lumens,
+                medium,
+            } => Source {
+                name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
+                power_w: ctx.positive(&f("power_w"), *power_w)?,
+                lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
+                emitter: Emitter::Ccfl {
+                    center: ctx.point(&f("center"), *center)?,
+                    axis: ctx.direction(&f("axis"), *axis)?,
+                    radius: ctx.positive(&f("radius_mm"), *radius_mm)?,
+                    length: ctx.positive(&f("length_mm"), *length_mm)?,
+                },
+                medium: medium_id(ctx, &f("medium"), medium, media)?,
+            },
+            SourceSpec::Led {
+                name,
+                center,
+                normal,
+                u,
+                width_mm,
+                height_mm,
+                power_w,
+                lumens,
+                cos_exponent,
+                intensity_file,
+                medium,
+            } => {
+                let n = ctx.direction(&f("normal"), *normal)?;
+                let u = ctx.direction(&f("u"), *u)?;
+                if u.dot(n).abs() > 1e-6 {
+                    return Err(ctx.err(&f("u"), "must be perpendicular to normal"));
+                }
+                let (center, width, height) = (
+                    ctx.point(&f("center"), *center)?,
+                    ctx.positive(&f("width_mm"), *width_mm)?,
+                    ctx.positive(&f("height_mm"), *height_mm)?,
+                );
+                Source {
+                    name: name.clone().unwrap_or_else(|| format!("led{i}")),
+                    power_w: ctx.positive(&f("power_w"), *power_w)?,
+                    lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
+                    emitter: match (intensity_file, cos_exponent) {
+                        (Some(_), Some(_)) => {
+                            return Err(ctx.err(
+                                &f("intensity_file"),
+                                "give either cos_exponent or intensity_file, not both",
+                            ));
+                        }
+                        (Some(file), None) => {
+                            let dir = ctx.0.parent().unwrap_or(Path::new("."));
+                            let profile = IntensityProfile::read(&dir.join(file))
+                                .map_err(|e| ctx.err(&f("intensity_file"), e))?;
+                            Emitter::MeasuredLed {
+                                center,
+                                normal: n,
+                                u,
+                                width,
+                                height,
+                                profile: Arc::new(profile),
+                            }
+                        }
+                        (None, m) => Emitter::Led {
+                            center,
+                            normal: n,
+                            u,
+                            width,
+                            height,
+                            cos_exponent: ctx.non_negative(&f("cos_exponent"), m.unwrap_or(1.0))?,
+                        },
+                    },
+                    medium: medium_id(ctx, &f("medium"), medium, media)?,
+                }
+            }
+        })
+    }
+}
 
 /// The emitting shape of a source.
 #[derive(Clone, Debug, PartialEq)]
@@ -134,10 +284,7 @@ impl Source {
                 height,
                 cos_exponent,
             } => {
-                let v = normal.cross(*u);
-                let p = *center
-                    + *u * ((rng.uniform() - 0.5) * width)
-                    + v * ((rng.uniform() - 0.5) * height);
+                let p = rectangle_point(*center, *normal, *u, (*width, *height), rng);
                 let d = sampling::cos_power(*normal, *cos_exponent, rng.uniform(), rng.uniform());
                 Ray::new(p, d)
             }
@@ -149,16 +296,27 @@ impl Source {
                 height,
                 profile,
             } => {
-                let v = normal.cross(*u);
-                let p = *center
-                    + *u * ((rng.uniform() - 0.5) * width)
-                    + v * ((rng.uniform() - 0.5) * height);
+                let p = rectangle_point(*center, *normal, *u, (*width, *height), rng);
                 let theta = profile.sample_theta(rng.uniform());
                 let d = sampling::around(*normal, theta.cos(), TAU * rng.uniform());
                 Ray::new(p, d)
             }
         }
     }
+}
+
+/// A uniform point on the emitting rectangle of an LED: centred at `center`, `width` along
+/// the unit `u`, `height` along `normal x u`. Both LED kinds start their photons here
+/// (two uniforms, width first); they differ only in the direction.
+fn rectangle_point(
+    center: DVec3,
+    normal: DVec3,
+    u: DVec3,
+    (width, height): (f64, f64),
+    rng: &mut PhotonRng,
+) -> DVec3 {
+    let v = normal.cross(u);
+    center + u * ((rng.uniform() - 0.5) * width) + v * ((rng.uniform() - 0.5) * height)
 }
 
 /// All sources of a scene with the cumulative power table used to pick one per photon.
@@ -182,6 +340,19 @@ impl Sources {
             })
             .collect();
         Self { list, cdf }
+    }
+
+    /// Check the scene file's `[[sources]]` entries and build the sources.
+    pub fn build(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<Sources> {
+        if specs.is_empty() {
+            return Err(ctx.err("sources", "the scene needs at least one [[sources]] entry"));
+        }
+        let list = specs
+            .iter()
+            .enumerate()
+            .map(|(i, s)| s.build(ctx, i, media))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self::new(list))
     }
 
     /// Move every source by `d`.

@@ -38,6 +38,9 @@
 //! ```toml
 //! density_grid = { width_mm = 68.0, values = [[0.02, 0.1, 0.5], [0.03, 0.12, 0.6]] }
 //! ```
+//!
+//! The density functions and their checks live in [`super::density`], shared with the
+//! groove fill of [`super::grooves`]; this module owns the lattice and the dots.
 
 pub use super::density::{Density, DensityGrid, XUnit};
 use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};

@@ -16,6 +16,12 @@ pub fn cos_power(axis: DVec3, m: f64, u1: f64, u2: f64) -> DVec3 {
 }
 
 /// The paper's equation (1): a Lambertian direction around the unit normal `n`.
+///
+/// The same distribution as [`cos_power`] with `m = 1`, but not the same numbers: this
+/// takes `sin theta = sqrt(u1)` directly where `cos_power` derives it from
+/// `cos theta = (1 - u1)^(1/2)`, which rounds differently. Kept separate so that traced
+/// outputs stay bit-identical to the paper's formula (surfaces and CCFLs) and to LEDs'
+/// `cos_exponent = 1`.
 pub fn lambertian(n: DVec3, u1: f64, u2: f64) -> DVec3 {
     let sin_t = u1.sqrt();
     let cos_t = (1.0 - u1).max(0.0).sqrt();

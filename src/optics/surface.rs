@@ -13,14 +13,15 @@
 
 use super::dots::DotPattern;
 use super::grooves::GroovePattern;
+use super::phong::Phong;
 use super::{dielectric, diffuser, lambert, mirror};
 use crate::geometry::SurfaceHit;
 use crate::rng::PhotonRng;
 use glam::DVec3;
 
-// The types a model's users name along with it.
+// Re-exported for the callers that name them along with the models (their homes are
+// `optics::medium` and `crate::estimator`).
 pub use super::medium::{Interface, Medium, MediumId};
-pub use super::phong::Phong;
 pub use crate::estimator::Estimator;
 
 /// The optical model of one tag.

@@ -43,9 +43,9 @@ use crate::optics::dots::DotsSpec;
 use crate::optics::grooves::GroovesSpec;
 use crate::optics::lambert::LambertSpec;
 pub use crate::optics::medium::MediumSpec;
-use crate::optics::medium::air;
 use crate::optics::mirror::MirrorSpec;
 use crate::optics::phong::PhongSpec;
+pub use crate::sources::SourceSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -119,62 +119,6 @@ pub enum SurfaceSpec {
     Mirror(MirrorSpec),
     /// Black absorber ([`crate::optics::absorber`]).
     Absorber(AbsorberSpec),
-}
-
-/// A light source.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-pub enum SourceSpec {
-    /// Cold-cathode fluorescent lamp: a Lambertian cylinder.
-    Ccfl {
-        /// Name for reports.
-        name: Option<String>,
-        /// Centre of the tube.
-        center: [f64; 3],
-        /// Tube axis.
-        axis: [f64; 3],
-        /// Radius (mm).
-        radius_mm: f64,
-        /// Length (mm).
-        length_mm: f64,
-        /// Radiant power (W).
-        power_w: f64,
-        /// Luminous flux (lm), for luminance outputs.
-        lumens: Option<f64>,
-        /// Medium around the tube.
-        #[serde(default = "air")]
-        medium: String,
-    },
-    /// Flat LED emitter.
-    Led {
-        /// Name for reports.
-        name: Option<String>,
-        /// Centre of the emitting rectangle.
-        center: [f64; 3],
-        /// Emitting normal.
-        normal: [f64; 3],
-        /// Width direction.
-        u: [f64; 3],
-        /// Width (mm).
-        width_mm: f64,
-        /// Height (mm).
-        height_mm: f64,
-        /// Radiant power (W).
-        power_w: f64,
-        /// Luminous flux (lm), for luminance outputs.
-        lumens: Option<f64>,
-        /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere); default 1.
-        /// Not with `intensity_file`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        cos_exponent: Option<f64>,
-        /// Measured intensity table, `.csv` or `.ies` (relative to the scene file); see
-        /// [`crate::sources::intensity`].
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        intensity_file: Option<PathBuf>,
-        /// Medium in front of the emitter.
-        #[serde(default = "air")]
-        medium: String,
-    },
 }
 
 /// The target plane.

@@ -15,14 +15,13 @@ mod solids;
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};
-use crate::optics::medium::{self, Medium, MediumId, medium_id};
+use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
 use crate::rng::PhotonRng;
-use crate::sources::intensity::IntensityProfile;
-use crate::sources::{Emitter, Source, Sources};
+use crate::sources::Sources;
 use crate::spec_check::Ctx;
 use anyhow::{Context, Result};
-use config::{DetectorSpec, SceneFile, SourceSpec, SurfaceSpec};
+use config::{DetectorSpec, SceneFile, SurfaceSpec};
 use glam::{DMat4, DVec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -104,7 +103,7 @@ impl Scene {
         }
         solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
         fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
-        let sources = build_sources(&ctx, &file.sources, &media)?;
+        let sources = Sources::build(&ctx, &file.sources, &media)?;
         let detector = build_detector(&ctx, &file.detector)?;
         if file.trace.max_bounces == 0 {
             return Err(ctx.err("trace.max_bounces", "must be at least 1"));
@@ -468,99 +467,6 @@ fn fit_patterns_to_faces(
         }
     }
     Ok(())
-}
-
-fn build_sources(ctx: &Ctx, specs: &[SourceSpec], media: &[Medium]) -> Result<Sources> {
-    if specs.is_empty() {
-        return Err(ctx.err("sources", "the scene needs at least one [[sources]] entry"));
-    }
-    let mut list = Vec::new();
-    for (i, s) in specs.iter().enumerate() {
-        let f = |k: &str| format!("sources[{i}].{k}");
-        list.push(match s {
-            SourceSpec::Ccfl {
-                name,
-                center,
-                axis,
-                radius_mm,
-                length_mm,
-                power_w,
-                lumens,
-                medium,
-            } => Source {
-                name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
-                power_w: ctx.positive(&f("power_w"), *power_w)?,
-                lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
-                emitter: Emitter::Ccfl {
-                    center: ctx.point(&f("center"), *center)?,
-                    axis: ctx.direction(&f("axis"), *axis)?,
-                    radius: ctx.positive(&f("radius_mm"), *radius_mm)?,
-                    length: ctx.positive(&f("length_mm"), *length_mm)?,
-                },
-                medium: medium_id(ctx, &f("medium"), medium, media)?,
-            },
-            SourceSpec::Led {
-                name,
-                center,
-                normal,
-                u,
-                width_mm,
-                height_mm,
-                power_w,
-                lumens,
-                cos_exponent,
-                intensity_file,
-                medium,
-            } => {
-                let n = ctx.direction(&f("normal"), *normal)?;
-                let u = ctx.direction(&f("u"), *u)?;
-                if u.dot(n).abs() > 1e-6 {
-                    return Err(ctx.err(&f("u"), "must be perpendicular to normal"));
-                }
-                let (center, width, height) = (
-                    ctx.point(&f("center"), *center)?,
-                    ctx.positive(&f("width_mm"), *width_mm)?,
-                    ctx.positive(&f("height_mm"), *height_mm)?,
-                );
-                Source {
-                    name: name.clone().unwrap_or_else(|| format!("led{i}")),
-                    power_w: ctx.positive(&f("power_w"), *power_w)?,
-                    lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
-                    emitter: match (intensity_file, cos_exponent) {
-                        (Some(_), Some(_)) => {
-                            return Err(ctx.err(
-                                &f("intensity_file"),
-                                "give either cos_exponent or intensity_file, not both",
-                            ));
-                        }
-                        (Some(file), None) => {
-                            let dir = ctx.0.parent().unwrap_or(Path::new("."));
-                            let profile = IntensityProfile::read(&dir.join(file))
-                                .map_err(|e| ctx.err(&f("intensity_file"), e))?;
-                            Emitter::MeasuredLed {
-                                center,
-                                normal: n,
-                                u,
-                                width,
-                                height,
-                                profile: Arc::new(profile),
-                            }
-                        }
-                        (None, m) => Emitter::Led {
-                            center,
-                            normal: n,
-                            u,
-                            width,
-                            height,
-                            cos_exponent: ctx.non_negative(&f("cos_exponent"), m.unwrap_or(1.0))?,
-                        },
-                    },
-                    medium: medium_id(ctx, &f("medium"), medium, media)?,
-                }
-            }
-        });
-    }
-    Ok(Sources::new(list))
 }
 
 fn build_detector(ctx: &Ctx, d: &DetectorSpec) -> Result<TargetPlane> {

@@ -1,7 +1,7 @@
 //! The `grooves` entry of the scene file and its checks (the format is shown in
 //! [`super`]).
 
-use super::{GroovePattern, Relief};
+use super::pattern::{GroovePattern, Relief};
 use crate::optics::density::{Density, Gradation, XUnit};
 use crate::optics::medium::{Interface, Medium, air};
 use crate::spec_check::Ctx;

@@ -1,0 +1,105 @@
+//! The optimizer's charts: `density.png`, `profile.png` and `density_map.png`.
+
+use super::OptimizeResult;
+use super::objective::Evaluation;
+use crate::optics::dots::{Density, DensityGrid};
+use crate::output::atomic::StagedDir;
+use crate::output::plot::{Chart, Scale, Series, write_chart};
+use crate::output::png::{PreviewOptions, write_false_colour};
+use anyhow::Result;
+use std::path::Path;
+
+impl OptimizeResult {
+    /// Stage `density.png`, `profile.png` and, for a density grid, `density_map.png`.
+    pub(super) fn write_charts(&self, staged: &mut StagedDir) -> Result<()> {
+        write_chart(&staged.stage_path("density.png"), &self.density_chart())?;
+        write_chart(&staged.stage_path("profile.png"), &self.profile_chart())?;
+        if let Density::Grid(g) = &self.final_density {
+            write_density_map(&staged.stage_path("density_map.png"), g)?;
+        }
+        Ok(())
+    }
+
+    /// Density against position along the axis, initial and final.
+    fn density_chart(&self) -> Chart {
+        let p = &self.pattern;
+        let n = 400;
+        let curve = |d: &Density| -> Vec<(f64, f64)> {
+            let mut q = p.clone();
+            q.density = d.clone();
+            (0..=n)
+                .map(|i| {
+                    let u = p.length * i as f64 / n as f64;
+                    (u, q.density_at(u))
+                })
+                .collect()
+        };
+        let across = match self.final_density {
+            Density::Grid(_) => ", mean across the axis",
+            _ => "",
+        };
+        Chart {
+            title: format!("Dot density d(x) on {} ({}{across})", self.tag, self.method),
+            x_label: "position along the propagation axis (mm)".into(),
+            y_label: "dot density d (area fraction)".into(),
+            x_scale: Scale::Linear,
+            y_scale: Scale::Linear,
+            series: vec![
+                Series::new("initial", curve(&self.initial_density)),
+                Series::new("final", curve(&self.final_density)),
+            ],
+        }
+    }
+
+    /// Flux profile along the axis (relative to its mean), initial and final.
+    fn profile_chart(&self) -> Chart {
+        let (a, b, what) = match &self.verification {
+            Some(v) => (
+                &v.initial.evaluation,
+                &v.final_design.evaluation,
+                "verification re-trace",
+            ),
+            None => (&self.initial, &self.best, "search traces"),
+        };
+        let rel = |e: &Evaluation| -> Vec<(f64, f64)> {
+            let used: Vec<f64> = e
+                .profile
+                .value
+                .iter()
+                .zip(&e.profile.used)
+                .filter(|(_, u)| **u)
+                .map(|(v, _)| *v)
+                .collect();
+            let mean = used.iter().sum::<f64>() / used.len().max(1) as f64;
+            e.profile
+                .u
+                .iter()
+                .zip(&e.profile.value)
+                .map(|(u, v)| (*u, v / mean))
+                .collect()
+        };
+        Chart {
+            title: format!("Flux profile along the axis ({what})"),
+            x_label: "position along the propagation axis (mm)".into(),
+            y_label: "flux / mean".into(),
+            x_scale: Scale::Linear,
+            y_scale: Scale::Linear,
+            series: vec![
+                Series::new(format!("initial, cv {:.3}", a.objective), rel(a)),
+                Series::new(format!("final, cv {:.3}", b.objective), rel(b)),
+            ],
+        }
+    }
+}
+
+/// False-colour map of a 2-D density grid's knots: columns along the axis (left to right
+/// from the lamps), rows across it (the first row at the bottom).
+fn write_density_map(path: &Path, g: &DensityGrid) -> Result<()> {
+    let (nx, ny) = g.shape();
+    let values: Vec<f64> = g.values.iter().flatten().copied().collect();
+    let opts = PreviewOptions {
+        min: Some(0.0),
+        max: None,
+    };
+    write_false_colour(path, nx, ny, &values, &opts)
+}

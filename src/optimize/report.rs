@@ -1,0 +1,68 @@
+//! One line per iteration: the progress report and a row of `history.csv`.
+
+use super::Method;
+use serde::Serialize;
+
+/// The state after one iteration, for progress lines and `history.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct IterationReport {
+    /// The method.
+    pub method: Method,
+    /// Iteration (0: the first design, or the initial simplex).
+    pub iteration: usize,
+    /// Designs evaluated so far (traced or rejected as infeasible).
+    pub evaluations: usize,
+    /// Photons traced so far.
+    pub photons: u64,
+    /// Wall time so far (s).
+    pub seconds: f64,
+    /// The best objective so far (profile cv).
+    pub objective: f64,
+    /// Its standard error.
+    pub noise: f64,
+    /// The cv noise alone would give.
+    pub noise_floor: f64,
+    /// cv of the whole flux map of the best design.
+    pub map_cv: f64,
+    /// cv of the flux map without the edge margins, of the best design.
+    pub area_cv: f64,
+    /// 13-point min/max of the best design.
+    pub thirteen_point: f64,
+    /// What the iteration did (Nelder-Mead step, or "feedback").
+    pub step: String,
+    /// The best design's parameters: polynomial coefficients, or knot densities.
+    pub params: Vec<f64>,
+}
+
+impl std::fmt::Display for IterationReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "iter {:>3}  evals {:>4}  photons {:>7.2}M  {:>6.1} s  cv {:.4} ± {:.4} (floor {:.4})  area cv {:.3}  map cv {:.3}  13-pt {:.3}  {:<12}",
+            self.iteration,
+            self.evaluations,
+            self.photons as f64 * 1e-6,
+            self.seconds,
+            self.objective,
+            self.noise,
+            self.noise_floor,
+            self.area_cv,
+            self.map_cv,
+            self.thirteen_point,
+            self.step
+        )?;
+        match self.method {
+            Method::NelderMead => {
+                let c: Vec<String> = self.params.iter().map(|c| format!("{c:.4}")).collect();
+                write!(f, "  c = [{}]", c.join(", "))
+            }
+            Method::Feedback => {
+                let (lo, hi) = self
+                    .params
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), d| (l.min(*d), h.max(*d)));
+                write!(f, "  d {lo:.3}..{hi:.3}")
+            }
+        }
+    }
+}

@@ -1,0 +1,106 @@
+//! The outcome of an optimization: designs, history, verification.
+
+use super::export::Dot;
+use super::objective::Evaluation;
+use super::report::IterationReport;
+use super::traced::TracedRun;
+use super::{Method, OptimizeOptions};
+use crate::optics::dots::{Density, DotPattern};
+use crate::run::summary::Summary;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// A design re-traced with the verification seed and photons.
+#[derive(Clone, Debug, Serialize)]
+pub struct VerifiedDesign {
+    /// The objective and profile of the re-trace.
+    pub evaluation: Evaluation,
+    /// The re-trace's summary (uniformity with jackknife standard errors).
+    pub summary: Summary,
+}
+
+/// The verification of the first and the final design.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verification {
+    /// Seed of the re-traces (no evaluation used it).
+    pub seed: u64,
+    /// Photons per re-trace.
+    pub photons: u64,
+    /// The first design.
+    pub initial: VerifiedDesign,
+    /// The final design.
+    pub final_design: VerifiedDesign,
+}
+
+/// The outcome of [`optimize`].
+#[derive(Clone, Debug, Serialize)]
+pub struct OptimizeResult {
+    /// The method.
+    pub method: Method,
+    /// The options used.
+    pub options: OptimizeOptions,
+    /// The original scene file.
+    pub scene_file: PathBuf,
+    /// The optimized surface's tag.
+    pub tag: String,
+    /// The first design's density.
+    #[serde(serialize_with = "ser_density")]
+    pub initial_density: Density,
+    /// The final design's density.
+    #[serde(serialize_with = "ser_density")]
+    pub final_density: Density,
+    /// One report per iteration.
+    pub history: Vec<IterationReport>,
+    /// Iterations done.
+    pub iterations: usize,
+    /// Designs evaluated.
+    pub evaluations: usize,
+    /// Photons traced by the search (verification excluded).
+    pub photons: u64,
+    /// Wall time of the search (s, verification excluded).
+    pub seconds: f64,
+    /// Why the search stopped.
+    pub termination: String,
+    /// The first design at the search's seed and photons.
+    pub initial: Evaluation,
+    /// The final design at the search's seed and photons.
+    pub best: Evaluation,
+    /// The re-traces with a fresh seed (None with `verify_photons = 0`).
+    pub verification: Option<Verification>,
+    /// Every dot of the final pattern.
+    #[serde(skip)]
+    pub dots: Vec<Dot>,
+    /// The final pattern (scene frame).
+    #[serde(skip)]
+    pub pattern: DotPattern,
+    #[serde(skip)]
+    pub(super) initial_run: TracedRun,
+    #[serde(skip)]
+    pub(super) final_run: TracedRun,
+}
+
+fn ser_density<S: serde::Serializer>(d: &Density, s: S) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    #[serde(rename_all = "snake_case")]
+    enum D<'a> {
+        Polynomial(&'a [f64]),
+        Table(&'a [[f64; 2]]),
+        Grid {
+            x_max: f64,
+            v_min: f64,
+            width: f64,
+            values: &'a [Vec<f64>],
+        },
+    }
+    match d {
+        Density::Polynomial(c) => D::Polynomial(c).serialize(s),
+        Density::Table(k) => D::Table(k).serialize(s),
+        Density::Grid(g) => D::Grid {
+            x_max: g.x_max,
+            v_min: g.v_min,
+            width: g.width,
+            values: &g.values,
+        }
+        .serialize(s),
+    }
+}

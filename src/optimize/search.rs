@@ -1,0 +1,249 @@
+//! The state of one search: the design space, the traces so far, the best design.
+
+use super::OptimizeOptions;
+use super::objective::{self, Evaluation};
+use super::report::IterationReport;
+use super::traced::TracedRun;
+use crate::optics::dots::{Density, DotPattern};
+use crate::optics::surface::SurfaceModel;
+use crate::run::RunOptions;
+use crate::scene::Scene;
+use anyhow::{Context, Result, bail};
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// The dot pattern of tag `tag_id`.
+pub(super) fn dots_pattern(scene: &Scene, tag_id: usize) -> Result<&DotPattern> {
+    match scene.surfaces.get(tag_id) {
+        Some(SurfaceModel::Dots { pattern, .. }) => Ok(pattern),
+        _ => bail!("tag {tag_id} is not a dots surface"),
+    }
+}
+
+/// The tag index of the dots surface to optimize.
+fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
+    let dots: Vec<usize> = (0..scene.surfaces.len())
+        .filter(|&i| matches!(scene.surfaces[i], SurfaceModel::Dots { .. }))
+        .collect();
+    let names = || {
+        dots.iter()
+            .map(|&i| scene.tags[i].as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match tag {
+        Some(t) => {
+            let i = scene
+                .tags
+                .iter()
+                .position(|x| x == t)
+                .with_context(|| format!("{}: no tag '{t}'", scene.path.display()))?;
+            if !dots.contains(&i) {
+                bail!(
+                    "{}: surface '{t}' is not model = \"dots\" (dots surfaces: {})",
+                    scene.path.display(),
+                    names()
+                );
+            }
+            Ok(i)
+        }
+        None => match dots[..] {
+            [i] => Ok(i),
+            [] => bail!(
+                "{}: no model = \"dots\" surface to optimize",
+                scene.path.display()
+            ),
+            _ => bail!(
+                "{}: several dots surfaces ({}): pick one with --tag",
+                scene.path.display(),
+                names()
+            ),
+        },
+    }
+}
+
+/// How far `density` leaves `[min, max]` anywhere on the pattern's span (0: feasible;
+/// infinite for non-finite values).
+pub fn violation(pattern: &DotPattern, density: &Density, min: f64, max: f64) -> f64 {
+    if let Density::Grid(g) = density {
+        // Bilinear values lie between the knots'.
+        return g
+            .values
+            .iter()
+            .flatten()
+            .map(|&d| {
+                if d.is_finite() {
+                    (min - d).max(d - max).max(0.0)
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(0.0, f64::max);
+    }
+    let samples = 2048;
+    let mut p = pattern.clone();
+    p.density = density.clone();
+    (0..=samples)
+        .map(|i| p.density_at(p.length * i as f64 / samples as f64))
+        .map(|d| {
+            if d.is_finite() {
+                (min - d).max(d - max).max(0.0)
+            } else {
+                f64::INFINITY
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// What the search needs while it runs.
+pub(super) struct Search<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) tag_id: usize,
+    pub(super) pattern: DotPattern,
+    pub(super) options: &'a OptimizeOptions,
+    pub(super) run_options: RunOptions,
+    pub(super) strips: usize,
+    pub(super) min: f64,
+    pub(super) max: f64,
+    pub(super) start: Instant,
+    pub(super) photons: u64,
+    pub(super) evaluations: usize,
+    /// The first traced design.
+    pub(super) first: Option<(TracedRun, Evaluation)>,
+    /// The best traced design and its density.
+    pub(super) best: Option<(TracedRun, Evaluation, Density)>,
+    /// Objective facts per evaluated parameter vector (for progress reports).
+    pub(super) seen: HashMap<Vec<u64>, Evaluation>,
+    pub(super) history: Vec<IterationReport>,
+}
+
+impl<'a> Search<'a> {
+    pub(super) fn new(scene: &'a Scene, options: &'a OptimizeOptions) -> Result<Self> {
+        let tag_id = dots_tag(scene, options.tag.as_deref())?;
+        let pattern = dots_pattern(scene, tag_id)?.clone();
+        let packing = pattern.lattice.max_packing();
+        let max = options.max_density.unwrap_or(packing).min(packing);
+        let min = options.min_density;
+        if !(min.is_finite() && min >= 0.0 && min < max) {
+            bail!("--min-density {min} must be within [0, {max:.4}) (the largest density allowed)");
+        }
+        if options.photons == 0 {
+            bail!("--photons must be at least 1");
+        }
+        let strips = options
+            .strips
+            .unwrap_or_else(|| objective::default_strips(scene, &pattern));
+        if strips < 2 {
+            bail!("need at least 2 profile strips, got {strips}");
+        }
+        if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.length) {
+            bail!(
+                "--edge-margin-mm {} must be >= 0 and leave part of the {:.1} mm span",
+                options.edge_margin_mm,
+                pattern.length
+            );
+        }
+        let run_options = RunOptions {
+            photons: options.photons,
+            seed: options.seed,
+            threads: options.threads,
+            backend: options.backend,
+            estimator: options.estimator,
+            ..RunOptions::default()
+        };
+        Ok(Search {
+            scene,
+            tag_id,
+            pattern,
+            options,
+            run_options,
+            strips,
+            min,
+            max,
+            start: Instant::now(),
+            photons: 0,
+            evaluations: 0,
+            first: None,
+            best: None,
+            seen: HashMap::new(),
+            history: Vec::new(),
+        })
+    }
+
+    /// The scene with the dots surface's density replaced.
+    pub(super) fn scene_with(&self, density: &Density) -> Scene {
+        let mut scene = self.scene.clone();
+        if let Some(SurfaceModel::Dots { pattern, .. }) = scene.surfaces.get_mut(self.tag_id) {
+            pattern.density = density.clone();
+        }
+        scene
+    }
+
+    /// The figure of merit and its standard error: for the 2-D feedback the area cv (the
+    /// non-uniformity it can fix is across the axis too) debiased by its noise floor
+    /// `sqrt(cv^2 - floor^2)` (per-bin noise dominates the raw area cv at few photons),
+    /// else the profile cv.
+    pub(super) fn score(&self, ev: &Evaluation) -> (f64, f64) {
+        if self.options.tunes_grid() {
+            let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
+                .max(0.0)
+                .sqrt();
+            let noise = ev.area_cv_noise * ev.area_cv / debiased.max(ev.area_cv_noise);
+            (debiased, noise)
+        } else {
+            (ev.objective, ev.noise)
+        }
+    }
+
+    /// Trace a design with the search's seed and photons; keeps the first and the best.
+    pub(super) fn evaluate(&mut self, density: &Density) -> Result<Evaluation> {
+        self.evaluations += 1;
+        let (run, ev) = TracedRun::trace(
+            self.scene_with(density),
+            &self.run_options,
+            self.strips,
+            self.options.edge_margin_mm,
+            self.tag_id,
+        )?;
+        self.photons += ev.photons;
+        if self.first.is_none() {
+            self.first = Some((run.clone(), ev.clone()));
+        }
+        let better = self
+            .best
+            .as_ref()
+            .is_none_or(|(_, b, _)| self.score(&ev).0 < self.score(b).0);
+        if better {
+            self.best = Some((run, ev.clone(), density.clone()));
+        }
+        Ok(ev)
+    }
+
+    /// Record and announce one iteration.
+    pub(super) fn report(
+        &mut self,
+        iteration: usize,
+        step: String,
+        params: Vec<f64>,
+        ev: &Evaluation,
+        progress: &mut dyn FnMut(&IterationReport),
+    ) {
+        let r = IterationReport {
+            method: self.options.method,
+            iteration,
+            evaluations: self.evaluations,
+            photons: self.photons,
+            seconds: self.start.elapsed().as_secs_f64(),
+            objective: ev.objective,
+            noise: ev.noise,
+            noise_floor: ev.noise_floor,
+            map_cv: ev.uniformity.cv,
+            area_cv: ev.area_cv,
+            thirteen_point: ev.uniformity.thirteen_point_min_over_max,
+            step,
+            params,
+        };
+        progress(&r);
+        self.history.push(r);
+    }
+}

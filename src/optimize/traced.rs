@@ -1,0 +1,84 @@
+//! A finished trace of one design, kept to write its outputs (`initial/`, `final/`).
+
+use super::objective::Evaluation;
+use super::search::dots_pattern;
+use crate::run::{self, ConvergenceRow, RunOptions, RunResult, StoppedBy};
+use crate::scene::Scene;
+use crate::tracer::Tally;
+use anyhow::Result;
+
+/// A finished trace kept for writing its outputs (`initial/`, `final/`).
+#[derive(Clone, Debug)]
+pub struct TracedRun {
+    /// The traced scene.
+    pub scene: Scene,
+    backend: &'static str,
+    options: RunOptions,
+    threads: usize,
+    tally: Tally,
+    groups: Vec<Tally>,
+    runtime_s: f64,
+    stopped_by: StoppedBy,
+    history: Vec<ConvergenceRow>,
+}
+
+impl TracedRun {
+    /// Trace `scene`; returns the run and its evaluation.
+    pub(super) fn trace(
+        scene: Scene,
+        options: &RunOptions,
+        strips: usize,
+        margin: f64,
+        tag_id: usize,
+    ) -> Result<(TracedRun, Evaluation)> {
+        let r = run::trace(&scene, options, &|_| {})?;
+        let pattern = dots_pattern(&scene, tag_id)?;
+        let evaluation = Evaluation::of(
+            &scene,
+            pattern,
+            r.flux_map(),
+            strips,
+            margin,
+            r.tally.ledger.photons,
+            r.runtime_s,
+        );
+        let RunResult {
+            scene: _,
+            backend,
+            options,
+            threads,
+            tally,
+            groups,
+            runtime_s,
+            stopped_by,
+            history,
+        } = r;
+        let traced = TracedRun {
+            scene,
+            backend,
+            options,
+            threads,
+            tally,
+            groups,
+            runtime_s,
+            stopped_by,
+            history,
+        };
+        Ok((traced, evaluation))
+    }
+
+    /// The run as a [`RunResult`] (for its summary and output files).
+    pub fn result(&self) -> RunResult<'_> {
+        RunResult {
+            scene: &self.scene,
+            backend: self.backend,
+            options: self.options.clone(),
+            threads: self.threads,
+            tally: self.tally.clone(),
+            groups: self.groups.clone(),
+            runtime_s: self.runtime_s,
+            stopped_by: self.stopped_by,
+            history: self.history.clone(),
+        }
+    }
+}

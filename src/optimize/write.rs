@@ -1,0 +1,117 @@
+//! Every output file of an optimization, written all or nothing.
+
+use super::{OptimizeResult, export};
+use crate::optics::dots::Density;
+use crate::output::atomic::StagedDir;
+use crate::scene::Scene;
+use crate::scene::config::SceneFile;
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+impl OptimizeResult {
+    /// `history.csv`: one row per iteration.
+    pub fn history_csv(&self) -> String {
+        let mut s = String::from(
+            "iteration,evaluations,photons,seconds,objective,objective_noise,noise_floor,area_cv,map_cv,thirteen_point,step",
+        );
+        match &self.final_density {
+            Density::Polynomial(c) => (0..c.len()).for_each(|k| {
+                let _ = write!(s, ",c{k}");
+            }),
+            Density::Table(k) => k.iter().for_each(|[x, _]| {
+                let _ = write!(s, ",d@{x:.5}");
+            }),
+            Density::Grid(g) => {
+                let (nx, ny) = g.shape();
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let _ = write!(s, ",d{i}_{j}");
+                    }
+                }
+            }
+        }
+        s.push('\n');
+        for r in &self.history {
+            let _ = write!(
+                s,
+                "{},{},{},{:.3},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{}",
+                r.iteration,
+                r.evaluations,
+                r.photons,
+                r.seconds,
+                r.objective,
+                r.noise,
+                r.noise_floor,
+                r.area_cv,
+                r.map_cv,
+                r.thirteen_point,
+                r.step
+            );
+            for p in &r.params {
+                let _ = write!(s, ",{p:.9e}");
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Write every output into `dir`: all files are staged and moved into place only
+    /// when everything has been written; returns the files and folders written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let toml_text = self.optimized_toml()?;
+        // The optimized scene must load as it is.
+        let dest = dir.join("optimized.toml");
+        let file: SceneFile = toml::from_str(&toml_text)
+            .map_err(|e| anyhow::anyhow!("optimized scene does not parse: {e}"))?;
+        Scene::from_file(&file, &dest).context("the optimized scene does not load")?;
+
+        let mut staged = StagedDir::new(dir)?;
+        staged.write_bytes("optimized.toml", toml_text.as_bytes())?;
+        staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
+        self.write_charts(&mut staged)?;
+        staged.write_bytes("dots.csv", export::to_csv(&self.dots).as_bytes())?;
+        staged.write_bytes("dots.svg", export::to_svg(&self.dots).as_bytes())?;
+        staged.write_bytes("dots.dxf", export::to_dxf(&self.dots).as_bytes())?;
+        staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
+
+        // initial/ and final/ are written into hidden folders first and renamed at the end.
+        let mut temps = TempDirs(Vec::new());
+        let mut subdirs = Vec::new();
+        for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
+            let temp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+            if temp.exists() {
+                std::fs::remove_dir_all(&temp)
+                    .with_context(|| format!("cannot remove {}", temp.display()))?;
+            }
+            temps.0.push(temp.clone());
+            run.result().write(&temp)?;
+            subdirs.push((temp, dir.join(name)));
+        }
+        let mut written = Vec::new();
+        for (temp, dest) in &subdirs {
+            if dest.exists() {
+                std::fs::remove_dir_all(dest)
+                    .with_context(|| format!("cannot replace {}", dest.display()))?;
+            }
+            std::fs::rename(temp, dest)
+                .with_context(|| format!("cannot move {} to {}", temp.display(), dest.display()))?;
+            written.push(dest.clone());
+        }
+        temps.0.clear();
+        let mut files = staged.commit()?;
+        files.extend(written);
+        Ok(files)
+    }
+}
+
+/// Folders removed when dropped (the staging folders of `initial/` and `final/`).
+struct TempDirs(Vec<PathBuf>);
+
+impl Drop for TempDirs {
+    fn drop(&mut self) {
+        for d in &self.0 {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
+}

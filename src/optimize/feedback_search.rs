@@ -180,17 +180,11 @@ fn feedback_settings(search: &Search) -> Result<feedback::Settings> {
 
 /// The extent of the optimized face across the pattern's axis (mm along `across`).
 fn face_v_range(search: &Search) -> (f64, f64) {
-    let mesh = &search.scene.mesh;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for prim in 0..mesh.len() as u32 {
-        if mesh.tri_tag[prim as usize] as usize != search.tag_id {
-            continue;
-        }
-        for c in mesh.corners(prim) {
-            let v = search.pattern.face_coords(c).y;
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
+    for c in search.face_triangles().into_iter().flatten() {
+        let v = search.pattern.face_coords(c).y;
+        lo = lo.min(v);
+        hi = hi.max(v);
     }
     if lo.is_finite() && hi > lo {
         (lo, hi)

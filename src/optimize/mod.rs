@@ -51,6 +51,7 @@ mod result;
 mod scene_edit;
 mod search;
 mod traced;
+mod verify;
 mod write;
 
 pub use options::{Method, OptimizeOptions};
@@ -59,12 +60,9 @@ pub use result::{OptimizeResult, Verification, VerifiedDesign};
 pub use search::violation;
 pub use traced::TracedRun;
 
-use crate::optics::dots::Density;
-use crate::run::RunOptions;
 use crate::scene::Scene;
 use anyhow::{Result, bail};
 use feedback_search::run_feedback;
-use glam::DVec3;
 use options::check_method_options;
 use polynomial_search::run_nelder_mead;
 use search::Search;
@@ -90,53 +88,12 @@ pub fn optimize(
     };
     let mut pattern = search.pattern.clone();
     pattern.density = final_density.clone();
-    let verification = if options.verify_photons > 0 {
-        let run_options = RunOptions {
-            photons: options.verify_photons,
-            seed: options.verification_seed(),
-            ..search.run_options.clone()
+    let dots = export::dots_on_face(&pattern, &search.face_triangles());
+    let (initial_run, final_run, verification) =
+        match verify::verify(&search, &initial_density, &final_density)? {
+            Some((i, f, v)) => (i, f, Some(v)),
+            None => (first_run, best_run, None),
         };
-        let verify = |density: &Density| -> Result<(TracedRun, VerifiedDesign)> {
-            let (run, evaluation) = TracedRun::trace(
-                search.scene_with(density),
-                &run_options,
-                search.strips,
-                options.edge_margin_mm,
-                search.tag_id,
-            )?;
-            let summary = run.result().summary();
-            Ok((
-                run,
-                VerifiedDesign {
-                    evaluation,
-                    summary,
-                },
-            ))
-        };
-        let (initial_run, initial) = verify(&initial_density)?;
-        let (final_run, final_design) = verify(&final_density)?;
-        Some((
-            initial_run,
-            final_run,
-            Verification {
-                seed: run_options.seed,
-                photons: options.verify_photons,
-                initial,
-                final_design,
-            },
-        ))
-    } else {
-        None
-    };
-    let triangles: Vec<[DVec3; 3]> = (0..scene.mesh.len() as u32)
-        .filter(|&p| scene.mesh.tri_tag[p as usize] as usize == search.tag_id)
-        .map(|p| scene.mesh.corners(p))
-        .collect();
-    let dots = export::dots_on_face(&pattern, &triangles);
-    let (initial_run, final_run, verification) = match verification {
-        Some((i, f, v)) => (i, f, Some(v)),
-        None => (first_run, best_run, None),
-    };
     Ok(OptimizeResult {
         method: options.method,
         options: options.clone(),

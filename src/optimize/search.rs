@@ -9,6 +9,7 @@ use crate::optics::surface::SurfaceModel;
 use crate::run::RunOptions;
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
+use glam::DVec3;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -217,6 +218,15 @@ impl<'a> Search<'a> {
             self.best = Some((run, ev.clone(), density.clone()));
         }
         Ok(ev)
+    }
+
+    /// The corners of the optimized face's triangles (scene frame).
+    pub(super) fn face_triangles(&self) -> Vec<[DVec3; 3]> {
+        let mesh = &self.scene.mesh;
+        (0..mesh.len() as u32)
+            .filter(|&p| mesh.tri_tag[p as usize] as usize == self.tag_id)
+            .map(|p| mesh.corners(p))
+            .collect()
     }
 
     /// Record and announce one iteration.

@@ -9,9 +9,7 @@
 //! ratio of the best design, photons and time so far), then the verification of the
 //! first and final design with error bars, and the files written.
 
-use super::{Method, OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
-use crate::accel::BackendChoice;
-use crate::optics::surface::Estimator;
+use super::{OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
 use crate::scene::Scene;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
@@ -21,92 +19,18 @@ use std::path::{Path, PathBuf};
 pub struct OptimizeArgs {
     /// Scene file (or a folder holding scene.toml).
     pub scene: PathBuf,
-    /// Nelder-Mead over the density polynomial (the paper's), or per-strip feedback.
-    #[arg(long, value_enum, default_value = "nelder-mead")]
-    pub method: Method,
-    /// Photons per evaluated design.
-    #[arg(long, default_value_t = 1_000_000)]
-    pub photons: u64,
-    /// Iteration cap (Nelder-Mead steps, or feedback rounds).
-    #[arg(long)]
-    pub max_iter: Option<usize>,
-    /// Stop once the objective (cv of the profile along the axis) is at or below this.
-    #[arg(long)]
-    pub target_cv: Option<f64>,
     /// Seed shared by every evaluation (default: the scene's trace.seed).
     #[arg(long)]
     pub seed: Option<u64>,
     /// Output folder (default: out/NAME-optimize-METHOD, NAME being the scene's name).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Degree of the density polynomial (default: the scene's, at least 3).
-    #[arg(long)]
-    pub degree: Option<usize>,
-    /// Smallest printable density (area fraction).
-    #[arg(long, default_value_t = 0.01)]
-    pub min_density: f64,
-    /// Largest density (default and at most: the lattice's packing limit).
-    #[arg(long)]
-    pub max_density: Option<f64>,
-    /// The dots surface to optimize (default: the scene's only one).
-    #[arg(long)]
-    pub tag: Option<String>,
-    /// Nelder-Mead: initial simplex step (density units at the far end).
-    #[arg(long, default_value_t = 0.2)]
-    pub initial_step: f64,
-    /// Nelder-Mead: stop once the simplex is smaller than this (density units).
-    #[arg(long, default_value_t = 2e-3)]
-    pub simplex_tol: f64,
-    /// Feedback: damping exponent of d <- d (target / measured)^alpha.
-    #[arg(long, default_value_t = 0.7)]
-    pub alpha: f64,
-    /// Feedback: weight of the neighbours' mean in a smoothing pass (0: none).
-    #[arg(long, default_value_t = 0.25)]
-    pub smoothing: f64,
-    /// Feedback: 1 (a table of knots along the axis) or 2 (a grid over the face, for
-    /// non-uniformity across the axis too, such as LEDs on an edge).
-    #[arg(long, default_value_t = 1)]
-    pub dims: usize,
-    /// Feedback with --dims 2: knots of the grid along and across the axis, as NX,NY
-    /// (default 56,28).
-    #[arg(long, value_parser = parse_cells)]
-    pub cells: Option<(usize, usize)>,
-    /// Profile strips along the axis (default: the detector's bins along it).
-    #[arg(long)]
-    pub strips: Option<usize>,
-    /// Leave this many mm at either end of the span out of the objective.
-    #[arg(long, default_value_t = 0.0)]
-    pub edge_margin_mm: f64,
-    /// Photons of the verification re-traces of the first and final design (0: none).
-    #[arg(long, default_value_t = 10_000_000)]
-    pub verify_photons: u64,
-    /// Seed of the verification re-traces (default: one no evaluation used).
-    #[arg(long)]
-    pub verify_seed: Option<u64>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// Intersection backend.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub backend: BackendChoice,
-    /// Analog roulette or absorption by weights.
-    #[arg(long, value_enum, default_value = "analog")]
-    pub estimator: Estimator,
+    /// How to optimize.
+    #[command(flatten)]
+    pub options: OptimizeOptions,
     /// No per-iteration lines.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// `NX,NY` of `--cells`.
-fn parse_cells(s: &str) -> Result<(usize, usize), String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    match parts[..] {
-        [a, b] => match (a.parse::<usize>(), b.parse::<usize>()) {
-            (Ok(a), Ok(b)) if a >= 2 && b >= 2 => Ok((a, b)),
-            _ => Err(format!("expected NX,NY with both at least 2, got '{s}'")),
-        },
-        _ => Err(format!("expected NX,NY, got '{s}'")),
-    }
 }
 
 /// Accept a scene folder as well as the file itself.
@@ -121,33 +45,9 @@ fn scene_path(p: &Path) -> PathBuf {
 impl OptimizeArgs {
     /// The options these arguments ask for, with the scene's defaults.
     pub fn options(&self, scene: &Scene) -> OptimizeOptions {
-        let d = OptimizeOptions::default();
         OptimizeOptions {
-            method: self.method,
-            photons: self.photons,
             seed: self.seed.unwrap_or(scene.default_seed),
-            max_iter: self.max_iter.unwrap_or(match self.method {
-                Method::NelderMead => d.max_iter,
-                Method::Feedback => 15,
-            }),
-            target_cv: self.target_cv,
-            degree: self.degree,
-            min_density: self.min_density,
-            max_density: self.max_density,
-            tag: self.tag.clone(),
-            initial_step: self.initial_step,
-            simplex_tol: self.simplex_tol,
-            alpha: self.alpha,
-            smoothing: self.smoothing,
-            dims: self.dims,
-            cells: self.cells,
-            strips: self.strips,
-            edge_margin_mm: self.edge_margin_mm,
-            verify_photons: self.verify_photons,
-            verify_seed: self.verify_seed,
-            threads: self.threads,
-            backend: self.backend,
-            estimator: self.estimator,
+            ..self.options.clone()
         }
     }
 }

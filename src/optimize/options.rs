@@ -3,6 +3,7 @@
 use crate::accel::BackendChoice;
 use crate::optics::surface::Estimator;
 use anyhow::{Result, bail};
+use clap::{Args, FromArgMatches};
 use serde::Serialize;
 
 /// The optimization method.
@@ -25,54 +26,85 @@ impl std::fmt::Display for Method {
     }
 }
 
-/// How to optimize.
-#[derive(Clone, Debug, Serialize)]
+/// How to optimize: the options of `blutrace optimize` (their defaults are the `#[arg]`
+/// defaults, also behind [`Default`]).
+#[derive(Clone, Debug, Serialize, clap::Args)]
 pub struct OptimizeOptions {
-    /// The method.
+    /// Nelder-Mead over the density polynomial (the paper's), or per-strip feedback.
+    #[arg(long, value_enum, default_value = "nelder-mead")]
     pub method: Method,
-    /// Photons per evaluation (per traced design).
+    /// Photons per evaluated design.
+    #[arg(long, default_value_t = 1_000_000)]
     pub photons: u64,
-    /// Seed shared by every evaluation (common random numbers).
+    /// Seed shared by every evaluation (common random numbers); `blutrace optimize
+    /// --seed`, whose default is the scene's `trace.seed`, sets it.
+    #[arg(skip = 1u64)]
     pub seed: u64,
-    /// Iteration cap (Nelder-Mead steps, or feedback rounds after the first trace).
+    /// Iteration cap (Nelder-Mead steps, or feedback rounds after the first trace);
+    /// default 60 for Nelder-Mead, 15 for feedback.
+    #[arg(
+        long,
+        default_value_t = 60,
+        default_value_if("method", "feedback", "15")
+    )]
     pub max_iter: usize,
-    /// Stop once the objective is at or below this (the objective bound).
+    /// Stop once the objective (cv of the profile along the axis) is at or below this.
+    #[arg(long)]
     pub target_cv: Option<f64>,
-    /// Degree of the density polynomial (Nelder-Mead); default: the scene's, at least 3.
+    /// Degree of the density polynomial (default: the scene's, at least 3).
+    #[arg(long)]
     pub degree: Option<usize>,
     /// Smallest printable density (area fraction).
+    #[arg(long, default_value_t = 0.01)]
     pub min_density: f64,
-    /// Largest density; default (and at most): the lattice's packing limit.
+    /// Largest density (default and at most: the lattice's packing limit).
+    #[arg(long)]
     pub max_density: Option<f64>,
     /// The dots surface to optimize (default: the scene's only one).
+    #[arg(long)]
     pub tag: Option<String>,
-    /// Nelder-Mead: initial simplex step, in density units at the far end.
+    /// Nelder-Mead: initial simplex step (density units at the far end).
+    #[arg(long, default_value_t = 0.2)]
     pub initial_step: f64,
-    /// Nelder-Mead: stop when the simplex is smaller than this (density units).
+    /// Nelder-Mead: stop once the simplex is smaller than this (density units).
+    #[arg(long, default_value_t = 2e-3)]
     pub simplex_tol: f64,
-    /// Feedback: damping exponent.
+    /// Feedback: damping exponent of d <- d (target / measured)^alpha.
+    #[arg(long, default_value_t = 0.7)]
     pub alpha: f64,
-    /// Feedback: smoothing weight of the neighbours (0: none).
+    /// Feedback: weight of the neighbours' mean in a smoothing pass (0: none).
+    #[arg(long, default_value_t = 0.25)]
     pub smoothing: f64,
-    /// Feedback: 1 (a table along the axis) or 2 (a grid over the face).
+    /// Feedback: 1 (a table of knots along the axis) or 2 (a grid over the face, for
+    /// non-uniformity across the axis too, such as LEDs on an edge).
+    #[arg(long, default_value_t = 1)]
     pub dims: usize,
-    /// Feedback in 2-D: knots of the grid along and across the axis (default 56 x 28).
+    /// Feedback with --dims 2: knots of the grid along and across the axis, as NX,NY
+    /// (default 56,28).
+    #[arg(long, value_parser = parse_cells)]
     pub cells: Option<(usize, usize)>,
     /// Profile strips along the axis (default: the detector's bins along it).
+    #[arg(long)]
     pub strips: Option<usize>,
-    /// Leave strips within this many mm of either end of the span out of the objective.
+    /// Leave this many mm at either end of the span out of the objective.
+    #[arg(long, default_value_t = 0.0)]
     pub edge_margin_mm: f64,
-    /// Photons of the verification re-traces (0: no re-trace; the optimization's own
-    /// traces of the first and best design are reported instead).
+    /// Photons of the verification re-traces of the first and final design (0: none; the
+    /// optimization's own traces of the first and best design are reported instead).
+    #[arg(long, default_value_t = 10_000_000)]
     pub verify_photons: u64,
-    /// Seed of the verification re-traces (default: a seed no evaluation used).
+    /// Seed of the verification re-traces (default: one no evaluation used).
+    #[arg(long)]
     pub verify_seed: Option<u64>,
-    /// Worker threads (None: all cores).
+    /// Worker threads (default: all cores).
+    #[arg(long)]
     pub threads: Option<usize>,
     /// Intersection backend.
+    #[arg(long, value_enum, default_value = "auto")]
     #[serde(skip)]
     pub backend: BackendChoice,
-    /// Estimator.
+    /// Analog roulette or absorption by weights.
+    #[arg(long, value_enum, default_value = "analog")]
     pub estimator: Estimator,
 }
 
@@ -81,42 +113,34 @@ impl OptimizeOptions {
     pub fn tunes_grid(&self) -> bool {
         self.method == Method::Feedback && self.dims == 2
     }
-}
 
-impl Default for OptimizeOptions {
-    fn default() -> Self {
-        Self {
-            method: Method::NelderMead,
-            photons: 1_000_000,
-            seed: 1,
-            max_iter: 60,
-            target_cv: None,
-            degree: None,
-            min_density: 0.01,
-            max_density: None,
-            tag: None,
-            initial_step: 0.2,
-            simplex_tol: 2e-3,
-            alpha: 0.7,
-            smoothing: 0.25,
-            dims: 1,
-            cells: None,
-            strips: None,
-            edge_margin_mm: 0.0,
-            verify_photons: 10_000_000,
-            verify_seed: None,
-            threads: None,
-            backend: BackendChoice::Auto,
-            estimator: Estimator::Analog,
-        }
-    }
-}
-
-impl OptimizeOptions {
     /// The seed of the verification re-traces.
     pub fn verification_seed(&self) -> u64 {
         self.verify_seed
             .unwrap_or_else(|| self.seed.wrapping_add(0x9E37_79B9))
+    }
+}
+
+impl Default for OptimizeOptions {
+    /// The options of `blutrace optimize` given no flags.
+    fn default() -> Self {
+        let command = Self::augment_args(clap::Command::new("optimize"));
+        let matches = command
+            .try_get_matches_from(["optimize"])
+            .expect("no flags parse");
+        Self::from_arg_matches(&matches).expect("the defaults are valid options")
+    }
+}
+
+/// `NX,NY` of `--cells`.
+fn parse_cells(s: &str) -> Result<(usize, usize), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts[..] {
+        [a, b] => match (a.parse::<usize>(), b.parse::<usize>()) {
+            (Ok(a), Ok(b)) if a >= 2 && b >= 2 => Ok((a, b)),
+            _ => Err(format!("expected NX,NY with both at least 2, got '{s}'")),
+        },
+        _ => Err(format!("expected NX,NY, got '{s}'")),
     }
 }
 
@@ -134,5 +158,55 @@ pub(super) fn check_method_options(options: &OptimizeOptions) -> Result<()> {
             bail!("--cells needs at least 2 knots each way, got {nx},{ny}")
         }
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The options `blutrace optimize` flags `args` give.
+    fn parse(args: &[&str]) -> OptimizeOptions {
+        let command = OptimizeOptions::augment_args(clap::Command::new("optimize"));
+        let matches = command
+            .try_get_matches_from(std::iter::once("optimize").chain(args.iter().copied()))
+            .unwrap();
+        OptimizeOptions::from_arg_matches(&matches).unwrap()
+    }
+
+    #[test]
+    fn defaults_are_the_documented_ones() {
+        let d = OptimizeOptions::default();
+        assert_eq!(d.method, Method::NelderMead);
+        assert_eq!((d.photons, d.seed, d.max_iter), (1_000_000, 1, 60));
+        assert_eq!(
+            (d.min_density, d.initial_step, d.simplex_tol),
+            (0.01, 0.2, 2e-3)
+        );
+        assert_eq!((d.alpha, d.smoothing, d.dims), (0.7, 0.25, 1));
+        assert_eq!((d.edge_margin_mm, d.verify_photons), (0.0, 10_000_000));
+        assert_eq!(
+            (d.backend, d.estimator),
+            (BackendChoice::Auto, Estimator::Analog)
+        );
+        assert!(d.target_cv.is_none() && d.degree.is_none() && d.max_density.is_none());
+        assert!(d.tag.is_none() && d.cells.is_none() && d.strips.is_none());
+        assert!(d.verify_seed.is_none() && d.threads.is_none());
+    }
+
+    #[test]
+    fn feedback_has_its_own_round_cap() {
+        assert_eq!(parse(&["--method", "feedback"]).max_iter, 15);
+        assert_eq!(
+            parse(&["--method", "feedback", "--max-iter", "3"]).max_iter,
+            3
+        );
+        assert_eq!(parse(&["--method", "nelder-mead"]).max_iter, 60);
+        assert_eq!(parse(&["--cells", "14,7"]).cells, Some((14, 7)));
+        assert!(
+            OptimizeOptions::augment_args(clap::Command::new("optimize"))
+                .try_get_matches_from(["optimize", "--cells", "1,7"])
+                .is_err()
+        );
     }
 }

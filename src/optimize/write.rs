@@ -75,43 +75,9 @@ impl OptimizeResult {
         staged.write_bytes("dots.dxf", export::to_dxf(&self.dots).as_bytes())?;
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
 
-        // initial/ and final/ are written into hidden folders first and renamed at the end.
-        let mut temps = TempDirs(Vec::new());
-        let mut subdirs = Vec::new();
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
-            let temp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-            if temp.exists() {
-                std::fs::remove_dir_all(&temp)
-                    .with_context(|| format!("cannot remove {}", temp.display()))?;
-            }
-            temps.0.push(temp.clone());
-            run.result().write(&temp)?;
-            subdirs.push((temp, dir.join(name)));
+            run.result().write(&staged.stage_dir(name))?;
         }
-        let mut written = Vec::new();
-        for (temp, dest) in &subdirs {
-            if dest.exists() {
-                std::fs::remove_dir_all(dest)
-                    .with_context(|| format!("cannot replace {}", dest.display()))?;
-            }
-            std::fs::rename(temp, dest)
-                .with_context(|| format!("cannot move {} to {}", temp.display(), dest.display()))?;
-            written.push(dest.clone());
-        }
-        temps.0.clear();
-        let mut files = staged.commit()?;
-        files.extend(written);
-        Ok(files)
-    }
-}
-
-/// Folders removed when dropped (the staging folders of `initial/` and `final/`).
-struct TempDirs(Vec<PathBuf>);
-
-impl Drop for TempDirs {
-    fn drop(&mut self) {
-        for d in &self.0 {
-            let _ = std::fs::remove_dir_all(d);
-        }
+        staged.commit()
     }
 }

@@ -5,7 +5,8 @@
 //! atomic per file. [`StagedDir::commit`] fsyncs every staged file before renaming any of
 //! them; dropping a `StagedDir` without committing (an error, a panic, Ctrl-C unwinding)
 //! deletes the temporary files, so a failed run leaves neither half-written nor partial
-//! output files behind.
+//! output files behind. A whole folder (written by its own `StagedDir`, say) can be staged
+//! the same way with [`StagedDir::stage_dir`].
 
 use std::fs::{self, OpenOptions};
 use std::path::{Component, Path, PathBuf};
@@ -27,6 +28,8 @@ struct Staged {
     dest: PathBuf,
     /// Already renamed to `dest` (so `Drop` must not touch it).
     renamed: bool,
+    /// A folder (from [`StagedDir::stage_dir`]) rather than a file.
+    is_dir: bool,
 }
 
 /// A set of output files written under temporary names inside one directory and moved to
@@ -77,6 +80,21 @@ impl StagedDir {
     /// `.`/`..`, or containing a path separator) still yields a usable temporary path, but
     /// [`commit`](Self::commit) then fails and nothing is renamed.
     pub fn stage_path(&mut self, name: &str) -> PathBuf {
+        self.stage(name, false)
+    }
+
+    /// Reserve the output folder `name` (a plain name, like [`stage_path`](Self::stage_path)'s)
+    /// and return the temporary path a writer should create it at; [`commit`](Self::commit)
+    /// replaces an existing folder of that name with it.
+    pub fn stage_dir(&mut self, name: &str) -> PathBuf {
+        let temp = self.stage(name, true);
+        // A stale folder of the same temporary name must not leak into the output.
+        let _ = fs::remove_dir_all(&temp);
+        temp
+    }
+
+    /// Reserve `name` as a file or a folder.
+    fn stage(&mut self, name: &str, is_dir: bool) -> PathBuf {
         if let Some(existing) = self.staged.iter().find(|s| s.name == name) {
             return existing.temp.clone();
         }
@@ -97,6 +115,7 @@ impl StagedDir {
             temp: temp.clone(),
             dest,
             renamed: false,
+            is_dir,
         });
         temp
     }
@@ -121,6 +140,16 @@ impl StagedDir {
             bail!("{}", self.errors.join("; "));
         }
         for s in &self.staged {
+            if s.is_dir {
+                if !s.temp.is_dir() {
+                    bail!(
+                        "staged output folder {} was never written ({})",
+                        s.name,
+                        s.temp.display()
+                    );
+                }
+                continue;
+            }
             let file = OpenOptions::new()
                 .write(true)
                 .open(&s.temp)
@@ -135,6 +164,10 @@ impl StagedDir {
                 .with_context(|| format!("cannot sync {}", s.temp.display()))?;
         }
         for s in &mut self.staged {
+            if s.is_dir && s.dest.is_dir() {
+                fs::remove_dir_all(&s.dest)
+                    .with_context(|| format!("cannot replace {}", s.dest.display()))?;
+            }
             fs::rename(&s.temp, &s.dest).with_context(|| {
                 format!("cannot rename {} to {}", s.temp.display(), s.dest.display())
             })?;
@@ -150,7 +183,11 @@ impl Drop for StagedDir {
     fn drop(&mut self) {
         for s in self.staged.iter().filter(|s| !s.renamed) {
             // The file may never have been created: ignore errors.
-            let _ = fs::remove_file(&s.temp);
+            if s.is_dir {
+                let _ = fs::remove_dir_all(&s.temp);
+            } else {
+                let _ = fs::remove_file(&s.temp);
+            }
         }
     }
 }
@@ -250,6 +287,36 @@ mod tests {
         let err = s.commit().unwrap_err();
         assert!(format!("{err:#}").contains("never.png"), "{err:#}");
         assert!(t.listing().is_empty(), "{:?}", t.listing());
+    }
+
+    #[test]
+    fn staged_folders_replace_old_ones_or_vanish() {
+        let t = TestDir::new("dirs");
+        fs::create_dir_all(t.0.join("run")).unwrap();
+        fs::write(t.0.join("run").join("old.txt"), b"old").unwrap();
+        let mut s = StagedDir::new(&t.0).unwrap();
+        s.write_bytes("a.json", b"{}").unwrap();
+        let run = s.stage_dir("run");
+        let mut inner = StagedDir::new(&run).unwrap();
+        inner.write_bytes("new.txt", b"new").unwrap();
+        inner.commit().unwrap();
+        let done = s.commit().unwrap();
+        assert_eq!(done, vec![t.0.join("a.json"), t.0.join("run")]);
+        assert_eq!(t.listing(), vec!["a.json", "run"]);
+        let run_listing: Vec<_> = fs::read_dir(t.0.join("run")).unwrap().collect();
+        assert_eq!(run_listing.len(), 1);
+        assert_eq!(fs::read(t.0.join("run").join("new.txt")).unwrap(), b"new");
+
+        let mut s = StagedDir::new(&t.0).unwrap();
+        let never = s.stage_dir("never");
+        assert!(s.commit().is_err(), "a folder never written is an error");
+        assert!(!never.exists());
+        {
+            let mut s = StagedDir::new(&t.0).unwrap();
+            let dropped = s.stage_dir("dropped");
+            fs::create_dir_all(dropped.join("sub")).unwrap();
+        }
+        assert_eq!(t.listing(), vec!["a.json", "run"]);
     }
 
     #[test]

@@ -1,93 +1,46 @@
-//! `optimized.toml`: the original scene file with the final density.
+//! `optimized.toml`: the original scene file with the final density, edited as the typed
+//! [`SceneFile`] and written by the `toml` crate (keys in alphabetical order):
+//!
+//! ```toml
+//! name = "notebook14-optimized"   # the original name with -optimized
+//!
+//! [[geometry]]
+//! file = "/abs/path/notebook14.obj"   # file paths made absolute
+//!
+//! [surfaces.lgp_back]
+//! model = "dots"
+//! density_table = [[0.01, 0.013], ...]   # or density = [...] or density_grid = {...}
+//! ```
+//!
+//! Keys the original left at their defaults are written out with their values.
 
 use super::OptimizeResult;
 use crate::optics::dots::Density;
-use anyhow::{Context, Result};
+use crate::scene::config::{DensityGridSpec, SceneFile, SourceSpec, SurfaceSpec};
+use anyhow::{Context, Result, bail};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 impl OptimizeResult {
     /// The scene file of the final design: the original with the new density, geometry
     /// and other file paths made absolute, so it traces from anywhere.
     pub fn optimized_toml(&self) -> Result<String> {
         let path = &self.scene_file;
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read scene file", path.display()))?;
-        let mut doc: toml::Table =
-            toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let mut file = read_scene_file(path)?;
         let base = path.parent().unwrap_or(Path::new("."));
-        let absolute = |v: &mut toml::Value| -> Result<()> {
-            if let toml::Value::String(s) = v {
-                let p = base.join(&*s);
-                let p = p
-                    .canonicalize()
-                    .with_context(|| format!("{}: cannot find {}", path.display(), p.display()))?;
-                *s = p.to_string_lossy().into_owned();
-            }
-            Ok(())
-        };
-        for section in ["geometry", "sources"] {
-            if let Some(toml::Value::Array(items)) = doc.get_mut(section) {
-                for item in items.iter_mut() {
-                    if let toml::Value::Table(t) = item {
-                        for (k, v) in t.iter_mut() {
-                            if k == "file" || k.ends_with("_file") {
-                                absolute(v)?;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        let surface = doc
-            .get_mut("surfaces")
-            .and_then(|s| s.as_table_mut())
-            .and_then(|s| s.get_mut(&self.tag))
-            .and_then(|s| s.as_table_mut())
+        make_paths_absolute(&mut file, path, base)?;
+        let surface = file
+            .surfaces
+            .get_mut(&self.tag)
             .with_context(|| format!("{}: no [surfaces.{}]", path.display(), self.tag))?;
-        surface.remove("density");
-        surface.remove("density_table");
-        surface.remove("density_grid");
-        match &self.final_density {
-            Density::Polynomial(c) => {
-                let c = c.iter().map(|&v| toml::Value::Float(v)).collect();
-                surface.insert("density".into(), toml::Value::Array(c));
-            }
-            Density::Table(k) => {
-                let knots = k
-                    .iter()
-                    .map(|[x, d]| {
-                        toml::Value::Array(vec![toml::Value::Float(*x), toml::Value::Float(*d)])
-                    })
-                    .collect();
-                surface.insert("density_table".into(), toml::Value::Array(knots));
-            }
-            Density::Grid(g) => {
-                let mut t = toml::Table::new();
-                t.insert("width_mm".into(), toml::Value::Float(g.width));
-                t.insert("v_min_mm".into(), toml::Value::Float(g.v_min));
-                let rows = g
-                    .values
-                    .iter()
-                    .map(|r| toml::Value::Array(r.iter().map(|&v| toml::Value::Float(v)).collect()))
-                    .collect();
-                t.insert("values".into(), toml::Value::Array(rows));
-                surface.insert("density_grid".into(), toml::Value::Table(t));
-            }
-        }
-        let name = doc
-            .get("name")
-            .and_then(|n| n.as_str())
-            .map(str::to_owned)
-            .unwrap_or_else(|| {
-                base.file_name()
-                    .map_or("scene".into(), |n| n.to_string_lossy().into_owned())
-            });
-        doc.insert(
-            "name".into(),
-            toml::Value::String(format!("{name}-optimized")),
-        );
-        let body = toml::to_string(&doc).context("cannot write the optimized scene as TOML")?;
+        set_density(surface, &self.final_density)
+            .with_context(|| format!("{}: [surfaces.{}]", path.display(), self.tag))?;
+        let name = file.name.clone().unwrap_or_else(|| {
+            base.file_name()
+                .map_or("scene".into(), |n| n.to_string_lossy().into_owned())
+        });
+        file.name = Some(format!("{name}-optimized"));
+        let body = to_toml(&file)?;
         let mut out = String::new();
         let _ = writeln!(
             out,
@@ -98,5 +51,128 @@ impl OptimizeResult {
         );
         out.push_str(&body);
         Ok(out)
+    }
+}
+
+/// `file` as TOML. Through a `toml::Value`, whose tables sort their keys: the sections
+/// and keys come out in alphabetical order, not in the structs' field order.
+fn to_toml(file: &SceneFile) -> Result<String> {
+    let value = toml::Value::try_from(file).context("cannot write the optimized scene")?;
+    toml::to_string(&value).context("cannot write the optimized scene as TOML")
+}
+
+/// The scene file at `path`, parsed.
+fn read_scene_file(path: &Path) -> Result<SceneFile> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read scene file", path.display()))?;
+    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Make the geometry files and the sources' intensity files absolute (they are relative
+/// to `base`, the folder of the scene file `path`).
+fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result<()> {
+    let absolute = |p: &mut PathBuf| -> Result<()> {
+        let joined = base.join(&*p);
+        let found = joined
+            .canonicalize()
+            .with_context(|| format!("{}: cannot find {}", path.display(), joined.display()))?;
+        *p = PathBuf::from(found.to_string_lossy().into_owned());
+        Ok(())
+    };
+    for g in &mut file.geometry {
+        absolute(&mut g.file)?;
+    }
+    for s in &mut file.sources {
+        if let SourceSpec::Led {
+            intensity_file: Some(f),
+            ..
+        } = s
+        {
+            absolute(f)?;
+        }
+    }
+    Ok(())
+}
+
+/// Replace the density of the dots surface `spec` by `density` (the one place that knows
+/// the spec's density fields).
+fn set_density(spec: &mut SurfaceSpec, density: &Density) -> Result<()> {
+    let SurfaceSpec::Dots {
+        density: polynomial,
+        density_table,
+        density_grid,
+        ..
+    } = spec
+    else {
+        bail!("not a model = \"dots\" surface");
+    };
+    (*polynomial, *density_table, *density_grid) = (None, None, None);
+    match density {
+        Density::Polynomial(c) => *polynomial = Some(c.clone()),
+        Density::Table(k) => *density_table = Some(k.clone()),
+        Density::Grid(g) => {
+            *density_grid = Some(DensityGridSpec {
+                width_mm: g.width,
+                v_min_mm: g.v_min,
+                values: g.values.clone(),
+            })
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::dots::DensityGrid;
+
+    /// A scene file as JSON, to compare two of them.
+    fn json(file: &SceneFile) -> serde_json::Value {
+        serde_json::to_value(file).unwrap()
+    }
+
+    #[test]
+    fn every_bundled_scene_survives_the_round_trip() {
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let mut n = 0;
+        for entry in std::fs::read_dir(&scenes).unwrap() {
+            let path = entry.unwrap().path().join("scene.toml");
+            if !path.exists() {
+                continue;
+            }
+            let file = read_scene_file(&path).unwrap();
+            let again: SceneFile = toml::from_str(&to_toml(&file).unwrap()).unwrap();
+            assert_eq!(json(&file), json(&again), "{}", path.display());
+            n += 1;
+        }
+        assert!(n > 0, "no scenes under {}", scenes.display());
+    }
+
+    #[test]
+    fn the_density_is_replaced_and_the_paths_made_absolute() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/notebook14/scene.toml");
+        let mut file = read_scene_file(&path).unwrap();
+        make_paths_absolute(&mut file, &path, path.parent().unwrap()).unwrap();
+        assert!(file.geometry.iter().all(|g| g.file.is_absolute()));
+        let spec = file.surfaces.get_mut("lgp_back").unwrap();
+        let grid = DensityGrid {
+            x_max: 1.0,
+            v_min: -2.0,
+            width: 4.0,
+            values: vec![vec![0.1, 0.2], vec![0.3, 0.4]],
+        };
+        for density in [
+            Density::Table(vec![[0.0, 0.1], [1.0, 0.3]]),
+            Density::Grid(grid),
+            Density::Polynomial(vec![0.1, 0.05]),
+        ] {
+            set_density(spec, &density).unwrap();
+            let text = toml::to_string(&toml::Value::try_from(&*spec).unwrap()).unwrap();
+            let keys = ["density =", "density_table", "density_grid"];
+            let present: Vec<_> = keys.iter().filter(|k| text.contains(*k)).collect();
+            assert_eq!(present.len(), 1, "{text}");
+        }
+        let mut other = file.surfaces.get("lgp_front").unwrap().clone();
+        assert!(set_density(&mut other, &Density::Polynomial(vec![0.1])).is_err());
     }
 }

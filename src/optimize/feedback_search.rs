@@ -142,19 +142,33 @@ fn feedback_rounds(
             .map_or(ev.clone(), |(_, b, _)| b.clone());
         let step = if iteration == 0 { "initial" } else { step };
         search.report(iteration, step.into(), design.params(), &best, progress);
-        if search.options.target_cv.is_some_and(|t| score <= t) {
-            return Ok(format!("objective bound reached after {iteration} rounds"));
-        }
-        if stalled >= feedback::STALL_ROUNDS {
-            return Ok(format!(
-                "no gain beyond the {score_name}'s noise in {stalled} rounds, after {iteration} rounds"
-            ));
-        }
-        if iteration >= search.options.max_iter {
-            return Ok(format!("iteration cap reached after {iteration} rounds"));
+        if let Some(reason) = stop_reason(search, score, stalled, iteration, score_name) {
+            return Ok(reason);
         }
         design.update(search.scene, &ev);
         iteration += 1;
+    }
+}
+
+/// Why the rounds stop after round `iteration` (scored `score`, `stalled` rounds in a
+/// row without a gain), or None to go on.
+fn stop_reason(
+    search: &Search,
+    score: f64,
+    stalled: usize,
+    iteration: usize,
+    score_name: &str,
+) -> Option<String> {
+    if search.options.target_cv.is_some_and(|t| score <= t) {
+        Some(format!("objective bound reached after {iteration} rounds"))
+    } else if stalled >= feedback::STALL_ROUNDS {
+        Some(format!(
+            "no gain beyond the {score_name}'s noise in {stalled} rounds, after {iteration} rounds"
+        ))
+    } else if iteration >= search.options.max_iter {
+        Some(format!("iteration cap reached after {iteration} rounds"))
+    } else {
+        None
     }
 }
 

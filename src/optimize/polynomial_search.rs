@@ -28,37 +28,83 @@ fn start_coefficients(s: &Search, degree: usize) -> Vec<f64> {
     c
 }
 
-/// Run Nelder-Mead on `search`; returns why it stopped.
-pub(super) fn run_nelder_mead(
-    search: &mut Search,
-    progress: &mut dyn FnMut(&IterationReport),
-) -> Result<String> {
+/// The scaled coefficients `z_k = c_k x_max^k`: each term's contribution at the far end,
+/// in density units.
+struct Scaling(Vec<f64>);
+
+impl Scaling {
+    fn new(x_max: f64, degree: usize) -> Self {
+        Scaling((0..=degree).map(|k| x_max.powi(k as i32)).collect())
+    }
+
+    /// Coefficients `c` of scaled coefficients `z`.
+    fn to_c(&self, z: &[f64]) -> Vec<f64> {
+        z.iter().zip(&self.0).map(|(z, s)| z / s).collect()
+    }
+
+    /// Scaled coefficients `z` of coefficients `c`.
+    fn to_z(&self, c: &[f64]) -> Vec<f64> {
+        c.iter().zip(&self.0).map(|(c, s)| c * s).collect()
+    }
+}
+
+/// The polynomial degree: `--degree`, else the scene's, at least 3.
+fn degree(search: &Search) -> usize {
     let scene_degree = match &search.pattern.density {
         Density::Polynomial(c) => c.len().saturating_sub(1),
         Density::Table(_) | Density::Grid(_) => 0,
     };
-    let degree = search.options.degree.unwrap_or(scene_degree.max(3));
-    let c0 = start_coefficients(search, degree);
-    let x_max = search.pattern.x_max();
-    // z_k = c_k x_max^k: the term's contribution at the far end, in density units.
-    let scale: Vec<f64> = (0..=degree).map(|k| x_max.powi(k as i32)).collect();
-    let to_c = |z: &[f64]| -> Vec<f64> { z.iter().zip(&scale).map(|(z, s)| z / s).collect() };
-    let z0: Vec<f64> = c0.iter().zip(&scale).map(|(c, s)| c * s).collect();
-    // Steps that keep the first simplex feasible where a sign allows it.
+    search.options.degree.unwrap_or(scene_degree.max(3))
+}
+
+/// Initial steps of `--initial-step` that keep the first simplex feasible where a sign
+/// allows it.
+fn initial_steps(search: &Search, scaling: &Scaling, z0: &[f64]) -> Vec<f64> {
     let h = search.options.initial_step;
-    let steps: Vec<f64> = (0..=degree)
+    (0..z0.len())
         .map(|k| {
-            let mut z = z0.clone();
+            let mut z = z0.to_vec();
             z[k] += h;
             let up = violation(
                 &search.pattern,
-                &Density::Polynomial(to_c(&z)),
+                &Density::Polynomial(scaling.to_c(&z)),
                 search.min,
                 search.max,
             );
             if up > 0.0 { -h } else { h }
         })
-        .collect();
+        .collect()
+}
+
+/// The key of a parameter vector in `Search::seen`.
+fn key(z: &[f64]) -> Vec<u64> {
+    z.iter().map(|v| v.to_bits()).collect()
+}
+
+/// The cost of scaled coefficients `z`: the objective, or `1000 + violation` for a
+/// design that leaves the allowed density range (not traced).
+fn cost(s: &mut Search, scaling: &Scaling, z: &[f64]) -> Result<f64> {
+    let density = Density::Polynomial(scaling.to_c(z));
+    let v = violation(&s.pattern, &density, s.min, s.max);
+    if v > 0.0 {
+        s.evaluations += 1;
+        return Ok(1000.0 + v.min(1e6));
+    }
+    let ev = s.evaluate(&density)?;
+    let objective = ev.objective;
+    s.seen.insert(key(z), ev);
+    Ok(objective)
+}
+
+/// Run Nelder-Mead on `search`; returns why it stopped.
+pub(super) fn run_nelder_mead(
+    search: &mut Search,
+    progress: &mut dyn FnMut(&IterationReport),
+) -> Result<String> {
+    let degree = degree(search);
+    let scaling = Scaling::new(search.pattern.x_max(), degree);
+    let z0 = scaling.to_z(&start_coefficients(search, degree));
+    let steps = initial_steps(search, &scaling, &z0);
     let settings = nelder_mead::Settings {
         max_iter: search.options.max_iter,
         target: search.options.target_cv,
@@ -66,32 +112,13 @@ pub(super) fn run_nelder_mead(
         ..nelder_mead::Settings::default()
     };
     let cell = RefCell::new(search);
-    let key = |z: &[f64]| z.iter().map(|v| v.to_bits()).collect::<Vec<u64>>();
-    let mut cost = |z: &[f64]| -> Result<f64> {
-        let mut s = cell.borrow_mut();
-        let density = Density::Polynomial(to_c(z));
-        let v = violation(&s.pattern, &density, s.min, s.max);
-        if v > 0.0 {
-            s.evaluations += 1;
-            return Ok(1000.0 + v.min(1e6));
-        }
-        let ev = s.evaluate(&density)?;
-        let objective = ev.objective;
-        s.seen.insert(key(z), ev);
-        Ok(objective)
-    };
+    let mut cost = |z: &[f64]| cost(&mut cell.borrow_mut(), &scaling, z);
     let mut on_iter = |it: &nelder_mead::Iteration| {
         let mut s = cell.borrow_mut();
-        let Some(ev) = s.seen.get(&key(it.best)).cloned() else {
-            return;
-        };
-        s.report(
-            it.iteration,
-            it.step.to_string(),
-            to_c(it.best),
-            &ev,
-            progress,
-        );
+        if let Some(ev) = s.seen.get(&key(it.best)).cloned() {
+            let c = scaling.to_c(it.best);
+            s.report(it.iteration, it.step.to_string(), c, &ev, progress);
+        }
     };
     let outcome = nelder_mead::minimize(&mut cost, &z0, &steps, &settings, &mut on_iter)?;
     Ok(format!(

@@ -96,6 +96,38 @@ pub fn violation(pattern: &DotPattern, density: &Density, min: f64, max: f64) ->
         .fold(0.0, f64::max)
 }
 
+/// The allowed density range `[min printable, max packing]`, checked.
+fn density_range(options: &OptimizeOptions, pattern: &DotPattern) -> Result<(f64, f64)> {
+    let packing = pattern.lattice.max_packing();
+    let max = options.max_density.unwrap_or(packing).min(packing);
+    let min = options.min_density;
+    if !(min.is_finite() && min >= 0.0 && min < max) {
+        bail!("--min-density {min} must be within [0, {max:.4}) (the largest density allowed)");
+    }
+    Ok((min, max))
+}
+
+/// The profile strips; checks them with `--photons` and `--edge-margin-mm`.
+fn checked_strips(scene: &Scene, options: &OptimizeOptions, pattern: &DotPattern) -> Result<usize> {
+    if options.photons == 0 {
+        bail!("--photons must be at least 1");
+    }
+    let strips = options
+        .strips
+        .unwrap_or_else(|| objective::default_strips(scene, pattern));
+    if strips < 2 {
+        bail!("need at least 2 profile strips, got {strips}");
+    }
+    if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.length) {
+        bail!(
+            "--edge-margin-mm {} must be >= 0 and leave part of the {:.1} mm span",
+            options.edge_margin_mm,
+            pattern.length
+        );
+    }
+    Ok(strips)
+}
+
 /// What the search needs while it runs.
 pub(super) struct Search<'a> {
     pub(super) scene: &'a Scene,
@@ -122,28 +154,8 @@ impl<'a> Search<'a> {
     pub(super) fn new(scene: &'a Scene, options: &'a OptimizeOptions) -> Result<Self> {
         let tag_id = dots_tag(scene, options.tag.as_deref())?;
         let pattern = dots_pattern(scene, tag_id)?.clone();
-        let packing = pattern.lattice.max_packing();
-        let max = options.max_density.unwrap_or(packing).min(packing);
-        let min = options.min_density;
-        if !(min.is_finite() && min >= 0.0 && min < max) {
-            bail!("--min-density {min} must be within [0, {max:.4}) (the largest density allowed)");
-        }
-        if options.photons == 0 {
-            bail!("--photons must be at least 1");
-        }
-        let strips = options
-            .strips
-            .unwrap_or_else(|| objective::default_strips(scene, &pattern));
-        if strips < 2 {
-            bail!("need at least 2 profile strips, got {strips}");
-        }
-        if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.length) {
-            bail!(
-                "--edge-margin-mm {} must be >= 0 and leave part of the {:.1} mm span",
-                options.edge_margin_mm,
-                pattern.length
-            );
-        }
+        let (min, max) = density_range(options, &pattern)?;
+        let strips = checked_strips(scene, options, &pattern)?;
         let run_options = RunOptions {
             photons: options.photons,
             seed: options.seed,

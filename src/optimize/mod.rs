@@ -36,6 +36,11 @@
 //! `optimized.toml`, `history.csv`, `density.png`, `profile.png` (and `density_map.png` for
 //! a density grid), `optimize.json`, the dot files and the two traces' outputs in
 //! `initial/` and `final/`.
+//!
+//! Inside: the options (`options`), the search state shared by both methods (`search`),
+//! the two drivers (`polynomial_search` for Nelder-Mead, `feedback_search`), the
+//! verification (`verify`), the outcome (`result`, `report`, `traced`) and its files
+//! (`write`, with `scene_edit` for `optimized.toml` and `charts` for the PNG charts).
 
 mod charts;
 pub mod cli;

@@ -32,7 +32,7 @@ pub struct Verification {
     pub final_design: VerifiedDesign,
 }
 
-/// The outcome of [`optimize`].
+/// The outcome of [`optimize`](super::optimize()).
 #[derive(Clone, Debug, Serialize)]
 pub struct OptimizeResult {
     /// The method.

@@ -63,7 +63,6 @@ pub use options::{Method, OptimizeOptions};
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};
 pub use search::violation;
-pub use traced::TracedRun;
 
 use crate::scene::Scene;
 use anyhow::{Result, bail};

@@ -97,21 +97,15 @@ fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result
 /// Replace the density of the dots surface `spec` by `density` (the one place that knows
 /// the spec's density fields).
 fn set_density(spec: &mut SurfaceSpec, density: &Density) -> Result<()> {
-    let SurfaceSpec::Dots {
-        density: polynomial,
-        density_table,
-        density_grid,
-        ..
-    } = spec
-    else {
+    let SurfaceSpec::Dots(dots) = spec else {
         bail!("not a model = \"dots\" surface");
     };
-    (*polynomial, *density_table, *density_grid) = (None, None, None);
+    (dots.density, dots.density_table, dots.density_grid) = (None, None, None);
     match density {
-        Density::Polynomial(c) => *polynomial = Some(c.clone()),
-        Density::Table(k) => *density_table = Some(k.clone()),
+        Density::Polynomial(c) => dots.density = Some(c.clone()),
+        Density::Table(k) => dots.density_table = Some(k.clone()),
         Density::Grid(g) => {
-            *density_grid = Some(DensityGridSpec {
+            dots.density_grid = Some(DensityGridSpec {
                 width_mm: g.width,
                 v_min_mm: g.v_min,
                 values: g.values.clone(),

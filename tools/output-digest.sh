@@ -45,7 +45,8 @@ keep = [i for i, h in enumerate(rows[0]) if h not in ("seconds", "time_s", "wall
 for r in rows:
     print(",".join(r[i] for i in keep if i < len(r)))
 PY
-      *.toml) grep -v '^#' "$f" | sha256sum | sed "s|-|$label/$rel|" ;;
+      # optimized.toml names its geometry by absolute path: hash it relative to the repo.
+      *.toml) grep -v '^#' "$f" | sed "s|$PWD/||g" | sha256sum | sed "s|-|$label/$rel|" ;;
       *) sha256sum "$f" | sed "s|$f|$label/$rel|" ;;
     esac
   done

@@ -16,7 +16,7 @@ use crate::optics::surface::Estimator;
 use crate::output::atomic::StagedDir;
 use crate::run::{ConvergenceRow, RunOptions, RunResult, Shard, StoppedBy, metrics};
 use crate::scene::Scene;
-use crate::tracer::Tally;
+use crate::tally::Tally;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -1,4 +1,6 @@
-//! Exact, order-independent accumulators for Monte Carlo tallies.
+//! What the photon loop scores: each photon's [`Fate`], the energy [`Ledger`], the
+//! per-chunk [`ChunkTally`] of [`Detection`]s and the run's [`Tally`], all built on exact,
+//! order-independent accumulators.
 //!
 //! Every tally keeps the sum and the sum of squares of per-photon contributions, so every
 //! output carries its standard error. Sums are kept in 128-bit fixed point with 2^-64
@@ -6,6 +8,8 @@
 //! associative, so any thread count, chunk order or shard split gives bit-identical
 //! totals, and 1e10 photons accumulate without drift. They are read out as f64.
 
+use crate::optics::surface::MediumId;
+use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 
 const FRACTION_BITS: i32 = 64;
@@ -201,6 +205,185 @@ impl TryFrom<SparseGrid> for Grid {
         }
         Ok(g)
     }
+}
+
+/// How one photon ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fate {
+    /// Reached the target plane.
+    Detected,
+    /// Absorbed by the surface with this tag index.
+    AbsorbedBySurface(u32),
+    /// Absorbed inside this medium (Beer-Lambert).
+    AbsorbedInMedium(MediumId),
+    /// Left the scene.
+    Escaped,
+    /// Stopped by the bounce cap.
+    Killed,
+    /// Ended by Russian roulette (weighted estimator).
+    Roulette,
+}
+
+/// Where the emitted energy went, in photon weights. Partial absorptions of the weighted
+/// estimator are booked as the weight before minus the weight after, so the books close
+/// exactly: `emitted == accounted()` bit for bit in every run.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Ledger {
+    /// Photons emitted.
+    pub photons: u64,
+    /// Surface interactions (roulette events).
+    pub interactions: u64,
+    /// Emitted weight.
+    pub emitted: ExactSum,
+    /// Weight detected on the target (sum and sum of squares per photon).
+    pub detected: BinStats,
+    /// Weight absorbed per surface tag.
+    pub absorbed_by_surface: Vec<ExactSum>,
+    /// Weight absorbed per medium.
+    pub absorbed_in_medium: Vec<ExactSum>,
+    /// Weight that left the scene.
+    pub escaped: ExactSum,
+    /// Weight stopped by the bounce cap.
+    pub killed: ExactSum,
+    /// Photons stopped by the bounce cap.
+    pub killed_photons: u64,
+    /// Net weight removed by Russian roulette (killed minus weight given to survivors).
+    pub roulette: ExactSum,
+}
+
+impl Ledger {
+    pub(crate) fn new(tags: usize, media: usize) -> Self {
+        Self {
+            absorbed_by_surface: vec![ExactSum::default(); tags],
+            absorbed_in_medium: vec![ExactSum::default(); media],
+            ..Default::default()
+        }
+    }
+
+    pub(crate) fn end(&mut self, fate: Fate, w: f64) {
+        match fate {
+            Fate::Detected => self.detected.add(w),
+            Fate::AbsorbedBySurface(t) => self.absorbed_by_surface[t as usize].add(w),
+            Fate::AbsorbedInMedium(m) => self.absorbed_in_medium[m as usize].add(w),
+            Fate::Escaped => self.escaped.add(w),
+            Fate::Killed => {
+                self.killed.add(w);
+                self.killed_photons += 1;
+            }
+            Fate::Roulette => self.roulette.add(w),
+        }
+    }
+
+    /// Book the weight lost between `before` and `after` at `sink`.
+    pub(crate) fn lose(sink: &mut ExactSum, before: f64, after: f64) {
+        sink.add(before);
+        sink.add(-after);
+    }
+
+    pub(crate) fn merge(&mut self, o: &Ledger) {
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Add another ledger, or take it out.
+    pub(crate) fn merge_signed(&mut self, o: &Ledger, sign: Sign) {
+        sign.apply_u64(&mut self.photons, o.photons);
+        sign.apply_u64(&mut self.interactions, o.interactions);
+        self.emitted.merge_signed(o.emitted, sign);
+        self.detected.merge_signed(&o.detected, sign);
+        for (mine, theirs) in [
+            (&mut self.absorbed_by_surface, &o.absorbed_by_surface),
+            (&mut self.absorbed_in_medium, &o.absorbed_in_medium),
+        ] {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                a.merge_signed(*b, sign);
+            }
+        }
+        self.escaped.merge_signed(o.escaped, sign);
+        self.killed.merge_signed(o.killed, sign);
+        sign.apply_u64(&mut self.killed_photons, o.killed_photons);
+        self.roulette.merge_signed(o.roulette, sign);
+    }
+
+    /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances).
+    pub fn accounted(&self) -> ExactSum {
+        let mut s =
+            ExactSum(self.detected.sum.0 + self.escaped.0 + self.killed.0 + self.roulette.0);
+        for a in self
+            .absorbed_by_surface
+            .iter()
+            .chain(&self.absorbed_in_medium)
+        {
+            s.merge(*a);
+        }
+        s
+    }
+}
+
+/// Everything a run scored.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Tally {
+    /// Flux bins on the target plane (photon weights).
+    pub flux: Grid,
+    /// (theta, phi) bins of detected directions (photon weights).
+    pub angular: Grid,
+    /// Energy ledger.
+    pub ledger: Ledger,
+}
+
+impl Tally {
+    /// An empty tally shaped for `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let (flux, angular) = scene.detector.empty_grids();
+        Self {
+            flux,
+            angular,
+            ledger: Ledger::new(scene.tags.len(), scene.media.len()),
+        }
+    }
+
+    /// Add another tally of the same scene.
+    pub fn merge(&mut self, o: &Tally) {
+        self.merge_signed(o, Sign::Add);
+    }
+
+    /// Add another tally of the same scene, or take out one that is part of this one.
+    pub fn merge_signed(&mut self, o: &Tally, sign: Sign) {
+        self.flux.merge_signed(&o.flux, sign);
+        self.angular.merge_signed(&o.angular, sign);
+        self.ledger.merge_signed(&o.ledger, sign);
+    }
+
+    /// Add the events of one traced chunk.
+    pub fn absorb(&mut self, c: &ChunkTally) {
+        for d in &c.detections {
+            self.flux.bins[d.flux_bin as usize].add(d.weight);
+            self.angular.bins[d.angular_bin as usize].add(d.weight);
+        }
+        self.ledger.merge(&c.ledger);
+    }
+}
+
+/// One detected photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detection {
+    /// Index of the flux bin.
+    pub flux_bin: u32,
+    /// Index of the angular bin.
+    pub angular_bin: u32,
+    /// Photon weight at detection.
+    pub weight: f64,
+}
+
+/// What one chunk of photons scored: a list of detections (cheap to ship between
+/// threads) and its ledger.
+#[derive(Clone, Debug)]
+pub struct ChunkTally {
+    /// Index of the chunk (photons `index * CHUNK ..`, [`crate::tracer::CHUNK`]).
+    pub index: u64,
+    /// Detections, in photon order.
+    pub detections: Vec<Detection>,
+    /// The chunk's ledger.
+    pub ledger: Ledger,
 }
 
 #[cfg(test)]

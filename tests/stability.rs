@@ -27,7 +27,7 @@ use blutrace::rng::PhotonRng;
 use blutrace::run::{RunOptions, RunResult};
 use blutrace::scene::Scene;
 use blutrace::tally::ExactSum;
-use blutrace::tracer::Ledger;
+use blutrace::tally::Ledger;
 use glam::{DMat3, DVec3};
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
@@ -1496,7 +1496,7 @@ fn furnace_weighted() -> Row {
     );
     let r = run_with(&s, n, 9, |o| o.estimator = Estimator::Weighted);
     let l = &r.tally.ledger;
-    let wall = |t: &blutrace::tracer::Tally| {
+    let wall = |t: &blutrace::tally::Tally| {
         let i = s.tags.iter().position(|t| t == "wall").unwrap();
         t.ledger.absorbed_by_surface[i].value() / t.ledger.photons as f64
     };
@@ -1605,7 +1605,7 @@ fn cavity(name: &str, walls: &str, floor: &str, cap: u32) -> Scene {
 /// raising the cap only ever turns capped photons into other fates, and from the first cap
 /// that caps nobody on, the tallies are identical.
 fn cap_ladder(label: &str, walls: &str, floor: &str, caps: &[u32], n: u64) -> (String, bool, f64) {
-    let mut prev: Option<(f64, u64, blutrace::tracer::Tally)> = None;
+    let mut prev: Option<(f64, u64, blutrace::tally::Tally)> = None;
     let mut ok = true;
     let mut shown = Vec::new();
     let mut last = 0.0;

@@ -4,7 +4,7 @@ use super::objective::Evaluation;
 use super::search::dots_pattern;
 use crate::run::{self, ConvergenceRow, RunOptions, RunResult, StoppedBy};
 use crate::scene::Scene;
-use crate::tracer::Tally;
+use crate::tally::Tally;
 use anyhow::Result;
 
 /// A finished trace kept for writing its outputs (`initial/`, `final/`).

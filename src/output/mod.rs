@@ -6,6 +6,8 @@
 //! - [`exr`]: multi-channel 32-bit float OpenEXR images (lossless ZIP compression) with
 //!   numeric header attributes, plus a reader for the files it writes.
 //! - [`png`]: false-colour previews (viridis colour map with a colour bar) for people.
+//! - [`colormap`]: the viridis colour map; `font`: the 5×7 pixel font of previews and charts.
+//! - [`plot`]: line charts (convergence, optimizer histories).
 //!
 //! Grid convention shared by [`exr`] and [`png`]: a `width × height` grid is a row-major
 //! slice, `x` fastest, and grid row 0 is the `y = 0` row (the lowest `y`). Both writers put
@@ -13,6 +15,8 @@
 //! grid with `y` pointing up.
 
 pub mod atomic;
+pub mod colormap;
 pub mod exr;
+pub(crate) mod font;
 pub mod plot;
 pub mod png;

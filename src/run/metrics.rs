@@ -11,8 +11,7 @@
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
 
 use crate::scene::Scene;
-use crate::tally::{Grid, Sign};
-use crate::tracer::Tally;
+use crate::tally::{Grid, Sign, Tally};
 use serde::Serialize;
 
 /// Number of interleaved photon groups kept for jackknife errors.

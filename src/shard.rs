@@ -204,9 +204,7 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
     let mut total = Tally::new(scene);
     groups.iter().for_each(|g| total.merge(g));
     let runtime_s: f64 = shards.iter().map(|(_, s)| s.runtime_s).sum();
-    let values = metrics::Metrics::of(scene, &total).named().map(|(_, v)| v);
-    let mut stderr = metrics::jackknife(scene, &groups);
-    stderr[7] = 0.0;
+    let (values, stderr) = metrics::with_errors(scene, &total, &groups);
     let row = ConvergenceRow {
         photons: total.ledger.photons,
         seconds: runtime_s,

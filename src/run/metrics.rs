@@ -226,19 +226,104 @@ impl Metrics {
         }
     }
 
-    /// The metrics as named values, in a fixed order (for CSV columns and jackknife).
-    pub fn named(&self) -> [(&'static str, f64); 8] {
+    /// Every [`Metric`]'s value.
+    pub fn values(&self) -> MetricValues {
         let u = &self.uniformity;
-        [
-            ("mean", u.mean),
-            ("efficiency", self.extraction_efficiency),
-            ("cv", u.cv),
-            ("cv_debiased", self.cv_debiased),
-            ("min_over_max", u.min_over_max),
-            ("nine_point", u.nine_point_min_over_max),
-            ("thirteen_point", u.thirteen_point_min_over_max),
-            ("mean_rel_stderr", self.mean_rel_stderr),
-        ]
+        MetricValues::from_fn(|m| match m {
+            Metric::Mean => u.mean,
+            Metric::Efficiency => self.extraction_efficiency,
+            Metric::Cv => u.cv,
+            Metric::CvDebiased => self.cv_debiased,
+            Metric::MinOverMax => u.min_over_max,
+            Metric::NinePoint => u.nine_point_min_over_max,
+            Metric::ThirteenPoint => u.thirteen_point_min_over_max,
+            Metric::MeanRelStderr => self.mean_rel_stderr,
+        })
+    }
+}
+
+/// The scalar metrics of a run, in their fixed order (of the CSV columns).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metric {
+    /// Mean irradiance over the target (W/mm^2).
+    Mean,
+    /// Detected over emitted power.
+    Efficiency,
+    /// RMS deviation over mean of the flux map.
+    Cv,
+    /// cv with the noise floor removed in quadrature.
+    CvDebiased,
+    /// Smallest bin over largest bin.
+    MinOverMax,
+    /// 9-point min/max.
+    NinePoint,
+    /// 13-point min/max.
+    ThirteenPoint,
+    /// Mean over lit bins of stderr / flux (itself an error: it has no error of its own).
+    MeanRelStderr,
+}
+
+impl Metric {
+    /// Every metric, in order.
+    pub const ALL: [Metric; 8] = [
+        Metric::Mean,
+        Metric::Efficiency,
+        Metric::Cv,
+        Metric::CvDebiased,
+        Metric::MinOverMax,
+        Metric::NinePoint,
+        Metric::ThirteenPoint,
+        Metric::MeanRelStderr,
+    ];
+
+    /// The metric's name (its CSV column).
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Mean => "mean",
+            Metric::Efficiency => "efficiency",
+            Metric::Cv => "cv",
+            Metric::CvDebiased => "cv_debiased",
+            Metric::MinOverMax => "min_over_max",
+            Metric::NinePoint => "nine_point",
+            Metric::ThirteenPoint => "thirteen_point",
+            Metric::MeanRelStderr => "mean_rel_stderr",
+        }
+    }
+}
+
+/// One number per [`Metric`] (values, or their standard errors), indexed by metric.
+/// Serialized as an array in [`Metric::ALL`] order.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct MetricValues([f64; Metric::ALL.len()]);
+
+impl MetricValues {
+    /// `f(metric)` for every metric.
+    pub fn from_fn(f: impl FnMut(Metric) -> f64) -> Self {
+        MetricValues(Metric::ALL.map(f))
+    }
+
+    /// The same number for every metric.
+    pub fn splat(x: f64) -> Self {
+        MetricValues([x; Metric::ALL.len()])
+    }
+
+    /// `(metric, number)` in [`Metric::ALL`] order.
+    pub fn iter(&self) -> impl Iterator<Item = (Metric, f64)> + '_ {
+        Metric::ALL.into_iter().zip(self.0)
+    }
+}
+
+impl std::ops::Index<Metric> for MetricValues {
+    type Output = f64;
+
+    fn index(&self, m: Metric) -> &f64 {
+        &self.0[m as usize]
+    }
+}
+
+impl std::ops::IndexMut<Metric> for MetricValues {
+    fn index_mut(&mut self, m: Metric) -> &mut f64 {
+        &mut self.0[m as usize]
     }
 }
 
@@ -252,30 +337,37 @@ pub fn median(mut values: Vec<f64>) -> f64 {
     }
 }
 
-/// Jackknife standard errors of every named metric from the per-group tallies.
+/// Jackknife standard errors of every metric from the per-group tallies.
 /// Returns NaN errors when fewer than two groups hold photons.
-pub fn jackknife(scene: &Scene, groups: &[Tally]) -> [f64; 8] {
+pub fn jackknife(scene: &Scene, groups: &[Tally]) -> MetricValues {
     let used: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
     let k = used.len();
     if k < 2 {
-        return [f64::NAN; 8];
+        return MetricValues::splat(f64::NAN);
     }
     let mut total = Tally::new(scene);
     used.iter().for_each(|g| total.merge(g));
     // Leaving a group out = taking it out of the total: exact, as the sums are integers.
-    let leave_out: Vec<[f64; 8]> = used
+    let leave_out: Vec<MetricValues> = used
         .iter()
         .map(|g| {
             let mut t = total.clone();
             t.merge_signed(g, Sign::Remove);
-            Metrics::of(scene, &t).named().map(|(_, v)| v)
+            Metrics::of(scene, &t).values()
         })
         .collect();
-    let mut se = [0.0; 8];
-    for (j, s) in se.iter_mut().enumerate() {
-        let mean = leave_out.iter().map(|v| v[j]).sum::<f64>() / k as f64;
-        let ss: f64 = leave_out.iter().map(|v| (v[j] - mean).powi(2)).sum();
-        *s = ((k - 1) as f64 / k as f64 * ss).sqrt();
-    }
-    se
+    MetricValues::from_fn(|m| {
+        let mean = leave_out.iter().map(|v| v[m]).sum::<f64>() / k as f64;
+        let ss: f64 = leave_out.iter().map(|v| (v[m] - mean).powi(2)).sum();
+        ((k - 1) as f64 / k as f64 * ss).sqrt()
+    })
+}
+
+/// Every metric of the tally `total` and its standard error (jackknife over `groups`,
+/// the same photons split by chunk); the per-bin metric, itself an error, gets none.
+pub fn with_errors(scene: &Scene, total: &Tally, groups: &[Tally]) -> (MetricValues, MetricValues) {
+    let values = Metrics::of(scene, total).values();
+    let mut stderr = jackknife(scene, groups);
+    stderr[Metric::MeanRelStderr] = 0.0;
+    (values, stderr)
 }

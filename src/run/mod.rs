@@ -30,7 +30,7 @@ use crate::scene::Scene;
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
-use metrics::{GROUPS, Map, Metrics};
+use metrics::{GROUPS, Map, Metric, MetricValues};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -55,15 +55,15 @@ pub enum TargetMetric {
 }
 
 impl TargetMetric {
-    /// Index into [`Metrics::named`].
-    fn index(self) -> usize {
+    /// The metric this target refers to.
+    pub fn metric(self) -> Metric {
         match self {
-            TargetMetric::Mean => 0,
-            TargetMetric::Efficiency => 1,
-            TargetMetric::Cv => 2,
-            TargetMetric::NinePoint => 5,
-            TargetMetric::ThirteenPoint => 6,
-            TargetMetric::Bin => 7,
+            TargetMetric::Mean => Metric::Mean,
+            TargetMetric::Efficiency => Metric::Efficiency,
+            TargetMetric::Cv => Metric::Cv,
+            TargetMetric::NinePoint => Metric::NinePoint,
+            TargetMetric::ThirteenPoint => Metric::ThirteenPoint,
+            TargetMetric::Bin => Metric::MeanRelStderr,
         }
     }
 }
@@ -175,10 +175,10 @@ pub struct ConvergenceRow {
     pub photons: u64,
     /// Tracing seconds so far.
     pub seconds: f64,
-    /// Metric values, in [`Metrics::named`] order.
-    pub values: [f64; 8],
+    /// Metric values.
+    pub values: MetricValues,
     /// Their standard errors.
-    pub stderr: [f64; 8],
+    pub stderr: MetricValues,
 }
 
 /// A finished trace.
@@ -290,8 +290,8 @@ impl Rounds {
             return Some(StoppedBy::Photons);
         }
         if let (Some(target), Some(row)) = (o.target_error, self.history.last()) {
-            let i = o.target_metric.index();
-            let rel = relative_error(o.target_metric, row.values[i], row.stderr[i]);
+            let m = o.target_metric.metric();
+            let rel = relative_error(m, row.values[m], row.stderr[m]);
             if rel <= target {
                 return Some(StoppedBy::TargetError);
             }
@@ -316,10 +316,7 @@ impl Rounds {
     }
 
     fn record(&mut self, scene: &Scene, seconds: f64) {
-        let values = Metrics::of(scene, &self.total).named().map(|(_, v)| v);
-        let mut stderr = metrics::jackknife(scene, &self.groups);
-        // The per-bin target is itself an error: report it without an error of its own.
-        stderr[7] = 0.0;
+        let (values, stderr) = metrics::with_errors(scene, &self.total, &self.groups);
         self.history.push(ConvergenceRow {
             photons: self.traced,
             seconds,
@@ -330,9 +327,9 @@ impl Rounds {
 }
 
 /// Relative standard error of a metric (the per-bin metric is already relative).
-fn relative_error(m: TargetMetric, value: f64, stderr: f64) -> f64 {
+fn relative_error(m: Metric, value: f64, stderr: f64) -> f64 {
     match m {
-        TargetMetric::Bin => value,
+        Metric::MeanRelStderr => value,
         _ if value != 0.0 && value.is_finite() => stderr / value.abs(),
         _ => f64::INFINITY,
     }

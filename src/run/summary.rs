@@ -1,6 +1,6 @@
 //! `summary.json`, `convergence.csv` and `convergence.png`.
 
-use super::metrics::{Metrics, Uniformity};
+use super::metrics::{Metric, MetricValues, Metrics, Uniformity};
 use super::{ConvergenceRow, RunResult, StoppedBy, TargetMetric, relative_error};
 use crate::optics::surface::Estimator;
 use crate::output::plot::{Chart, Scale, Series, write_chart};
@@ -130,7 +130,9 @@ impl RunResult<'_> {
     /// The run's summary.
     pub fn summary(&self) -> Summary {
         let metrics = Metrics::of(self.scene, &self.tally);
-        let se = self.final_row().map_or([f64::NAN; 8], |r| r.stderr);
+        let se = self
+            .final_row()
+            .map_or(MetricValues::splat(f64::NAN), |r| r.stderr);
         let l = &self.tally.ledger;
         let w = self.watts_per_photon();
         let named = |names: &[String], sums: &[crate::tally::ExactSum]| {
@@ -145,9 +147,9 @@ impl RunResult<'_> {
         let d = &self.scene.detector;
         let target = self.options.target_metric;
         let rel = relative_error(
-            target,
-            metrics.named()[target.index()].1,
-            se[target.index()],
+            target.metric(),
+            metrics.values()[target.metric()],
+            se[target.metric()],
         );
         let runtime = self.runtime_s.max(1e-9);
         Summary {
@@ -179,15 +181,15 @@ impl RunResult<'_> {
             extraction_efficiency_stderr: eff_se,
             uniformity: metrics.uniformity,
             uniformity_stderr: Uniformity {
-                mean: se[0],
-                cv: se[2],
-                min_over_max: se[4],
-                nine_point_min_over_max: se[5],
-                thirteen_point_min_over_max: se[6],
+                mean: se[Metric::Mean],
+                cv: se[Metric::Cv],
+                min_over_max: se[Metric::MinOverMax],
+                nine_point_min_over_max: se[Metric::NinePoint],
+                thirteen_point_min_over_max: se[Metric::ThirteenPoint],
             },
             cv_noise_floor: metrics.cv_noise_floor,
             cv_debiased: metrics.cv_debiased,
-            cv_debiased_stderr: se[3],
+            cv_debiased_stderr: se[Metric::CvDebiased],
             mean_rel_stderr: metrics.mean_rel_stderr,
             figure_of_merit: FigureOfMerit {
                 metric: target,
@@ -215,15 +217,14 @@ impl RunResult<'_> {
 
 /// The convergence history as CSV: photons, seconds, then each metric and its stderr.
 pub fn convergence_csv(history: &[ConvergenceRow]) -> String {
-    let names = Metrics::default().named().map(|(n, _)| n);
     let mut s = String::from("photons,seconds");
-    for n in names {
+    for n in Metric::ALL.map(Metric::name) {
         let _ = write!(s, ",{n},{n}_stderr");
     }
     s.push('\n');
     for r in history {
         let _ = write!(s, "{},{:.6}", r.photons, r.seconds);
-        for (v, e) in r.values.iter().zip(&r.stderr) {
+        for ((_, v), (_, e)) in r.values.iter().zip(r.stderr.iter()) {
             let _ = write!(s, ",{v:.9e},{e:.9e}");
         }
         s.push('\n');
@@ -233,40 +234,31 @@ pub fn convergence_csv(history: &[ConvergenceRow]) -> String {
 
 /// Relative error against run time on log-log axes, with the 1/sqrt(t) reference line.
 pub fn write_convergence_png(path: &Path, history: &[ConvergenceRow]) -> Result<()> {
-    let names = Metrics::default().named().map(|(n, _)| n);
     let shown = [
-        (0, "mean flux"),
-        (1, "efficiency"),
-        (2, "cv"),
-        (6, "13-point"),
-        (7, "bin (mean)"),
+        (Metric::Mean, "mean flux"),
+        (Metric::Efficiency, "efficiency"),
+        (Metric::Cv, "cv"),
+        (Metric::ThirteenPoint, "13-point"),
+        (Metric::MeanRelStderr, "bin (mean)"),
     ];
     let mut series: Vec<Series> = shown
         .iter()
-        .map(|&(i, label)| Series {
+        .map(|&(m, label)| Series {
             label: label.to_string(),
             points: history
                 .iter()
-                .map(|r| {
-                    (
-                        r.seconds,
-                        if names[i] == "mean_rel_stderr" {
-                            r.values[i]
-                        } else {
-                            r.stderr[i] / r.values[i].abs()
-                        },
-                    )
-                })
+                .map(|r| (r.seconds, relative_error(m, r.values[m], r.stderr[m])))
                 .collect(),
             dashed: false,
             markers: true,
         })
         .collect();
+    let mean = Metric::Mean;
     if let Some(first) = history
         .iter()
-        .find(|r| r.seconds > 0.0 && r.stderr[0] > 0.0)
+        .find(|r| r.seconds > 0.0 && r.stderr[mean] > 0.0)
     {
-        let e0 = first.stderr[0] / first.values[0];
+        let e0 = first.stderr[mean] / first.values[mean];
         let t_end = history
             .last()
             .map_or(first.seconds, |r| r.seconds)

@@ -41,9 +41,39 @@ impl TargetPlane {
         self.u.cross(self.v)
     }
 
+    /// Size of one flux bin along u and v (mm).
+    pub fn bin_size(&self) -> [f64; 2] {
+        [
+            self.size[0] / self.bins[0] as f64,
+            self.size[1] / self.bins[1] as f64,
+        ]
+    }
+
     /// Area of one flux bin (mm^2).
     pub fn bin_area(&self) -> f64 {
-        (self.size[0] / self.bins[0] as f64) * (self.size[1] / self.bins[1] as f64)
+        let [bx, by] = self.bin_size();
+        bx * by
+    }
+
+    /// Area of the target rectangle (m^2).
+    pub fn area_m2(&self) -> f64 {
+        self.size[0] * self.size[1] * 1e-6
+    }
+
+    /// Centre of bin `(ix, iy)` of an `nx` x `ny` grid over the target (the detector's
+    /// own flux bins, or a map of another resolution).
+    pub fn grid_centre(&self, [nx, ny]: [usize; 2], ix: usize, iy: usize) -> DVec3 {
+        let (bx, by) = (self.size[0] / nx as f64, self.size[1] / ny as f64);
+        self.origin + self.u * ((ix as f64 + 0.5) * bx) + self.v * ((iy as f64 + 0.5) * by)
+    }
+
+    /// Flux bins along the in-plane axis (u or v) closer to `axis`.
+    pub fn bins_along(&self, axis: DVec3) -> usize {
+        if self.u.dot(axis).abs() >= self.v.dot(axis).abs() {
+            self.bins[0]
+        } else {
+            self.bins[1]
+        }
     }
 
     /// Where `ray` crosses the rectangle forwards, nearer than `tmax`: distance and
@@ -71,6 +101,29 @@ impl TargetPlane {
             i.min(self.bins[k] - 1)
         };
         (f(0), f(1))
+    }
+
+    /// Index of the flux bin holding `ab` in the flux grid (row-major, x fastest).
+    pub fn flux_index(&self, ab: [f64; 2]) -> usize {
+        let (ix, iy) = self.flux_bin(ab);
+        iy * self.bins[0] + ix
+    }
+
+    /// Index of the angular bin of `dir` in the angular grid (theta fastest).
+    pub fn angular_index(&self, dir: DVec3) -> usize {
+        let (it, ip) = self.angular_bin(dir);
+        ip * self.angular_bins[0] + it
+    }
+
+    /// Angular bin widths (degrees): theta, phi.
+    pub fn angular_bin_deg(&self) -> [f64; 2] {
+        let [nt, np] = self.angular_bins;
+        [90.0 / nt as f64, 360.0 / np as f64]
+    }
+
+    /// Polar angle (degrees) at the centre of angular bin row `it`.
+    pub fn theta_centre_deg(&self, it: usize) -> f64 {
+        90.0 * (it as f64 + 0.5) / self.angular_bins[0] as f64
     }
 
     /// The (theta, phi) bin of a detected direction.

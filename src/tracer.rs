@@ -246,11 +246,9 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
 
 fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Detection {
     let d = &scene.detector;
-    let (ix, iy) = d.flux_bin(ab);
-    let (it, ip) = d.angular_bin(dir);
     Detection {
-        flux_bin: (iy * d.bins[0] + ix) as u32,
-        angular_bin: (ip * d.angular_bins[0] + it) as u32,
+        flux_bin: d.flux_index(ab) as u32,
+        angular_bin: d.angular_index(dir) as u32,
         weight,
     }
 }

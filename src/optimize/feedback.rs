@@ -181,10 +181,9 @@ pub fn measured_per_cell(
     let mut sum = vec![vec![0.0; nx]; ny];
     let mut count = vec![vec![0usize; nx]; ny];
     let d = &scene.detector;
-    let (bx, by) = (d.size[0] / map.nx as f64, d.size[1] / map.ny as f64);
     for iy in 0..map.ny {
         for ix in 0..map.nx {
-            let centre = d.origin + d.u * ((ix as f64 + 0.5) * bx) + d.v * ((iy as f64 + 0.5) * by);
+            let centre = d.grid_centre([map.nx, map.ny], ix, iy);
             let q = pattern.face_coords(centre);
             if !(0.0..pattern.length).contains(&q.x)
                 || q.y < grid.v_min

@@ -45,12 +45,11 @@ pub fn strip_of_bins(
 ) -> Vec<Option<usize>> {
     let strips = strips.max(1);
     let d = &scene.detector;
-    let (bx, by) = (d.size[0] / nx as f64, d.size[1] / ny as f64);
     let width = pattern.length / strips as f64;
     let mut out = Vec::with_capacity(nx * ny);
     for iy in 0..ny {
         for ix in 0..nx {
-            let centre = d.origin + d.u * ((ix as f64 + 0.5) * bx) + d.v * ((iy as f64 + 0.5) * by);
+            let centre = d.grid_centre([nx, ny], ix, iy);
             let u = (centre - pattern.origin).dot(pattern.axis);
             out.push(
                 (0.0..pattern.length)
@@ -212,10 +211,5 @@ impl Evaluation {
 
 /// Strips to use by default: the detector's bins along the direction closer to `axis`.
 pub fn default_strips(scene: &Scene, pattern: &DotPattern) -> usize {
-    let d = &scene.detector;
-    if d.u.dot(pattern.axis).abs() >= d.v.dot(pattern.axis).abs() {
-        d.bins[0]
-    } else {
-        d.bins[1]
-    }
+    scene.detector.bins_along(pattern.axis)
 }

@@ -51,7 +51,7 @@ pub fn angular_map(scene: &Scene, t: &Tally) -> Map {
 pub fn luminance_map(scene: &Scene, t: &Tally) -> Option<Map> {
     let efficacy = scene.sources.luminous_efficacy()?;
     let d = &scene.detector;
-    let area_m2 = d.size[0] * d.size[1] * 1e-6;
+    let area_m2 = d.area_m2();
     let g = &t.angular;
     let m = grid_map(scene, t, g, |i| {
         d.angular_bin_projected_solid_angle(i % g.nx) * area_m2 / efficacy
@@ -64,7 +64,7 @@ pub fn luminance_map(scene: &Scene, t: &Tally) -> Option<Map> {
 pub fn luminance_by_theta(scene: &Scene, t: &Tally) -> Option<Vec<[f64; 3]>> {
     let efficacy = scene.sources.luminous_efficacy()?;
     let d = &scene.detector;
-    let area_m2 = d.size[0] * d.size[1] * 1e-6;
+    let area_m2 = d.area_m2();
     let (nt, np) = (t.angular.nx, t.angular.ny);
     let watts = scene.sources.total_power();
     let rows = (0..nt).map(|it| {
@@ -72,7 +72,7 @@ pub fn luminance_by_theta(scene: &Scene, t: &Tally) -> Option<Vec<[f64; 3]>> {
         (0..np).for_each(|ip| row.merge(&t.angular.bins[ip * nt + it]));
         let (mean, se) = row.mean_and_stderr(t.ledger.photons);
         let k = watts * efficacy / (area_m2 * d.angular_bin_projected_solid_angle(it) * np as f64);
-        [90.0 * (it as f64 + 0.5) / nt as f64, mean * k, se * k]
+        [d.theta_centre_deg(it), mean * k, se * k]
     });
     Some(rows.collect())
 }

@@ -361,7 +361,7 @@ impl RunResult<'_> {
         let mut staged = StagedDir::new(dir)?;
         let flux = self.flux_map();
         let d = &self.scene.detector;
-        let bin = [d.size[0] / d.bins[0] as f64, d.size[1] / d.bins[1] as f64];
+        let bin = d.bin_size();
         let common = [
             ("photons", self.tally.ledger.photons as f64),
             ("seed", self.options.seed as f64),
@@ -382,9 +382,10 @@ impl RunResult<'_> {
             &flux_attrs,
         )?;
         let ang = self.angular_map();
+        let [bin_theta, bin_phi] = d.angular_bin_deg();
         let ang_attrs = [
-            ("bin_theta_deg", 90.0 / ang.ny as f64),
-            ("bin_phi_deg", 360.0 / ang.nx as f64),
+            ("bin_theta_deg", bin_theta),
+            ("bin_phi_deg", bin_phi),
             common[0],
             common[1],
         ];

@@ -207,7 +207,7 @@ impl RunResult<'_> {
             detector: DetectorSummary {
                 size_mm: d.size,
                 bins: d.bins,
-                bin_size_mm: [d.size[0] / d.bins[0] as f64, d.size[1] / d.bins[1] as f64],
+                bin_size_mm: d.bin_size(),
                 angular_bins: d.angular_bins,
             },
             warnings: self.scene.warnings.clone(),

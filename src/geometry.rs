@@ -28,6 +28,74 @@ impl Ray {
     }
 }
 
+/// The spawn offset for a scene whose coordinates reach `extent` mm: a few f32 ulps
+/// there, so single-precision backends never re-hit the surface a ray leaves.
+pub fn spawn_epsilon(extent: f64) -> f64 {
+    16.0 * f32::EPSILON as f64 * extent.max(1.0)
+}
+
+/// The start of a ray leaving a surface at `point` (unit `normal`) along `dir`: nudged
+/// `eps` off the surface to the side `dir` goes. One rule for all backends.
+pub fn spawn_origin(point: DVec3, normal: DVec3, dir: DVec3, eps: f64) -> DVec3 {
+    point + normal * eps.copysign(dir.dot(normal))
+}
+
+/// A ray leaving a surface (pbrt's `SpawnRay`): where the photon really is, and the
+/// search ray a backend is asked about, nudged off the surface so single-precision
+/// backends do not re-hit it. The nudge is applied here and taken off here
+/// ([`SpawnedRay::refine_hit`]): distances are measured from the true position, so
+/// nudges never add up over thousands of bounces in a thin guide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpawnedRay {
+    /// Where the photon really is (on the surface it left, or where it was emitted).
+    pub from: DVec3,
+    /// The search ray: same direction, from `from` nudged off the surface.
+    pub search: Ray,
+}
+
+impl SpawnedRay {
+    /// A ray that left no surface (an emitted photon): no nudge.
+    pub fn unnudged(ray: Ray) -> Self {
+        Self {
+            from: ray.origin,
+            search: ray,
+        }
+    }
+
+    /// A ray leaving a surface at `point` (unit `normal`) along `dir`, nudged `eps`
+    /// ([`spawn_origin`]).
+    pub fn leaving(point: DVec3, normal: DVec3, dir: DVec3, eps: f64) -> Self {
+        Self {
+            from: point,
+            search: Ray::new(spawn_origin(point, normal, dir, eps), dir),
+        }
+    }
+
+    /// The ray from the true position.
+    pub fn true_ray(&self) -> Ray {
+        Ray::new(self.from, self.search.dir)
+    }
+
+    /// [`Mesh::refine_hit`] of the search ray's hit, but with distance and point measured
+    /// along the true path: the backend's triangle `prim`, at `t_backend` along the search
+    /// ray. Where the true path meets the triangle's plane outside the triangle (the
+    /// nudged ray went past an edge the true path does not), the nudged ray's point is
+    /// kept: a point off the triangle could lie outside a closed solid and leak.
+    pub fn refine_hit(&self, mesh: &Mesh, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
+        let (pos, ray) = (self.from, &self.search);
+        let lead = (ray.origin - pos).length();
+        let exact = mesh.refine_hit(&Ray::new(pos, ray.dir), prim, t_backend + lead, normal);
+        if exact.t > lead && mesh.contains(prim, exact.point) {
+            return exact;
+        }
+        let nudged = mesh.refine_hit(ray, prim, t_backend, normal);
+        SurfaceHit {
+            t: (nudged.point - pos).length(),
+            ..nudged
+        }
+    }
+}
+
 /// An axis-aligned bounding box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -160,52 +228,15 @@ impl Mesh {
             .all(|&(u, v)| (v - u).cross(p - u).dot(n) >= 0.0)
     }
 
-    /// [`Mesh::refine_hit`] for a photon really at `pos` whose search ray `ray` (same
-    /// direction) was nudged off the surface it left: the backend's triangle, but distance
-    /// and point measured along the true path from `pos`, so nudges never add up over many
-    /// bounces. Where the true path meets the triangle's plane outside the triangle (the
-    /// nudged ray went past an edge the true path does not), the nudged ray's point is
-    /// kept: a point off the triangle could lie outside a closed solid and leak.
-    pub fn refine_hit_from(&self, pos: DVec3, ray: &Ray, prim: u32, t_backend: f64) -> SurfaceHit {
-        self.refine_hit_from_on(pos, ray, prim, t_backend, self.normal(prim))
-    }
-
-    /// [`Mesh::refine_hit_from`] with the triangle's unit normal given (from
-    /// [`Mesh::unit_normals`]).
-    pub fn refine_hit_from_on(
-        &self,
-        pos: DVec3,
-        ray: &Ray,
-        prim: u32,
-        t_backend: f64,
-        normal: DVec3,
-    ) -> SurfaceHit {
-        let lead = (ray.origin - pos).length();
-        let exact = self.refine_hit_on(&Ray::new(pos, ray.dir), prim, t_backend + lead, normal);
-        if exact.t > lead && self.contains(prim, exact.point) {
-            return exact;
-        }
-        let nudged = self.refine_hit_on(ray, prim, t_backend, normal);
-        SurfaceHit {
-            t: (nudged.point - pos).length(),
-            ..nudged
-        }
-    }
-
     /// Exact (f64) intersection of `ray` with triangle `prim` within `(0, tmax)`.
     pub fn intersect_triangle(&self, ray: &Ray, prim: u32, tmax: f64) -> Option<f64> {
         intersect_triangle(ray, self.corners(prim), tmax)
     }
 
     /// Turn a backend's (distance, primitive) into a full hit, recomputing the distance
-    /// in f64 against the triangle's plane so every backend yields the same point.
-    pub fn refine_hit(&self, ray: &Ray, prim: u32, t_backend: f64) -> SurfaceHit {
-        self.refine_hit_on(ray, prim, t_backend, self.normal(prim))
-    }
-
-    /// [`Mesh::refine_hit`] with the triangle's unit normal given (from
-    /// [`Mesh::unit_normals`]).
-    pub fn refine_hit_on(&self, ray: &Ray, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
+    /// in f64 against the plane of triangle `prim` (unit `normal`, from
+    /// [`Mesh::unit_normals`]) so every backend yields the same point.
+    pub fn refine_hit(&self, ray: &Ray, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
         let a = self.positions[self.triangles[prim as usize][0] as usize];
         let denom = normal.dot(ray.dir);
         let t_plane = if denom.abs() > 1e-300 {
@@ -368,12 +399,23 @@ mod tests {
         let pos = DVec3::new(0.5, 0.1, 0.0);
         let nudged = Ray::new(pos + DVec3::Z * 1e-3, dir);
         let t = mesh.intersect_triangle(&nudged, 0, f64::INFINITY).unwrap();
-        let hit = mesh.refine_hit_from(pos, &nudged, 0, t);
+        let spawned = SpawnedRay {
+            from: pos,
+            search: nudged,
+        };
+        let hit = spawned.refine_hit(&mesh, 0, t, mesh.normal(0));
         assert!((hit.t - 1.0 / dir.z).abs() < 1e-12 && (hit.point.z - 1.0).abs() < 1e-12);
         assert!(mesh.contains(0, hit.point) && !mesh.contains(1, hit.point));
         // The true path meets the plane outside triangle 1: the nudged point is kept.
-        let far = mesh.refine_hit_from(DVec3::new(2.0, 0.1, 0.0), &nudged, 1, t);
-        assert_eq!(far.point, mesh.refine_hit(&nudged, 1, t).point);
+        let far = SpawnedRay {
+            from: DVec3::new(2.0, 0.1, 0.0),
+            search: nudged,
+        };
+        let far = far.refine_hit(&mesh, 1, t, mesh.normal(1));
+        assert_eq!(
+            far.point,
+            mesh.refine_hit(&nudged, 1, t, mesh.normal(1)).point
+        );
     }
 
     #[test]

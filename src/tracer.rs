@@ -15,7 +15,7 @@
 //! not depend on the thread count.
 
 use crate::accel::Accel;
-use crate::geometry::Ray;
+use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, MediumId, Outcome};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
@@ -48,11 +48,8 @@ pub struct Tracer<'a> {
 
 /// A photon in flight.
 struct Photon {
-    /// Where the photon really is (on the surface it last left).
-    pos: DVec3,
-    /// Its search ray: from `pos` along its direction, nudged off that surface by the
-    /// scene's spawn offset so single-precision backends do not re-hit it.
-    ray: Ray,
+    /// Where it is and where it goes (nudged off the surface it last left).
+    ray: SpawnedRay,
     medium: MediumId,
     weight: f64,
 }
@@ -63,8 +60,7 @@ impl Tracer<'_> {
         let mut rng = PhotonRng::new(seed, index);
         let (ray, medium) = self.scene.sources.sample(&mut rng);
         let mut p = Photon {
-            pos: ray.origin,
-            ray,
+            ray: SpawnedRay::unnudged(ray),
             medium,
             weight: 1.0,
         };
@@ -78,19 +74,8 @@ impl Tracer<'_> {
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
         for _ in 0..scene.max_bounces {
-            // Distances are measured from the true position, so spawn nudges never
-            // accumulate over thousands of bounces in a thin guide.
-            let true_ray = Ray::new(p.pos, p.ray.dir);
-            let surf = match scene.convex_solid(p.medium).filter(|_| self.convex) {
-                Some(solid) => solid.exit(&scene.mesh, &true_ray).map(|h| {
-                    let n = self.normals[h.prim as usize];
-                    scene.mesh.refine_hit_on(&true_ray, h.prim, h.t, n)
-                }),
-                None => self.accel.intersect(&p.ray, f64::INFINITY).map(|h| {
-                    let n = self.normals[h.prim as usize];
-                    scene.mesh.refine_hit_from_on(p.pos, &p.ray, h.prim, h.t, n)
-                }),
-            };
+            let true_ray = p.ray.true_ray();
+            let surf = self.nearest_surface(p, &true_ray);
             let t_surface = surf.map_or(f64::INFINITY, |h| h.t);
             let detected = scene.detector.intersect(&true_ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
@@ -99,7 +84,7 @@ impl Tracer<'_> {
             }
             if let Some((_, ab)) = detected {
                 out.detections
-                    .push(detection(scene, ab, p.ray.dir, p.weight));
+                    .push(detection(scene, ab, true_ray.dir, p.weight));
                 return Fate::Detected;
             }
             let Some(surf) = surf else {
@@ -111,7 +96,7 @@ impl Tracer<'_> {
             match model.interact(
                 &scene.media,
                 &surf,
-                p.ray.dir,
+                true_ray.dir,
                 p.medium,
                 self.estimator,
                 rng,
@@ -129,8 +114,7 @@ impl Tracer<'_> {
                         w,
                     );
                     p.weight = w;
-                    p.pos = surf.point;
-                    p.ray = Ray::new(scene.spawn_point(surf.point, surf.normal, dir), dir);
+                    p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                 }
             }
@@ -139,6 +123,22 @@ impl Tracer<'_> {
             }
         }
         Fate::Killed
+    }
+
+    /// The surface `p` reaches first along `true_ray` (its path from its true position).
+    fn nearest_surface(&self, p: &Photon, true_ray: &Ray) -> Option<SurfaceHit> {
+        let scene = self.scene;
+        match scene.convex_solid(p.medium).filter(|_| self.convex) {
+            // The convex path needs no nudge: it finds the exit from the true position.
+            Some(solid) => solid.exit(&scene.mesh, true_ray).map(|h| {
+                let n = self.normals[h.prim as usize];
+                scene.mesh.refine_hit(true_ray, h.prim, h.t, n)
+            }),
+            None => self.accel.intersect(&p.ray.search, f64::INFINITY).map(|h| {
+                let n = self.normals[h.prim as usize];
+                p.ray.refine_hit(&scene.mesh, h.prim, h.t, n)
+            }),
+        }
     }
 
     /// Beer-Lambert over a segment of length `t`: false when the photon is absorbed

@@ -18,9 +18,9 @@ use blutrace::accel::brute::BruteForce;
 use blutrace::accel::bvh::ObvhsBvh;
 use blutrace::accel::embree::EmbreeAccel;
 use blutrace::accel::{self, Accel, BackendChoice, Hit};
-use blutrace::geometry::{Mesh, Ray, orthonormal_basis};
+use blutrace::geometry::{Mesh, Ray, orthonormal_basis, spawn_epsilon};
 use blutrace::rng::PhotonRng;
-use blutrace::scene::{Scene, spawn_epsilon};
+use blutrace::scene::Scene;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
@@ -714,7 +714,9 @@ fn scene_queries(scene: &Scene, photons: u64, bounces: usize, seed: u64) -> Vec<
                 let Some(h) = oracle.intersect(&ray, f64::INFINITY) else {
                     break;
                 };
-                let s = scene.mesh.refine_hit(&ray, h.prim, h.t);
+                let s = scene
+                    .mesh
+                    .refine_hit(&ray, h.prim, h.t, scene.mesh.normal(h.prim));
                 let mut d = unit_sphere(&mut rng);
                 if d.dot(s.normal) == 0.0 {
                     d = s.normal;

@@ -37,7 +37,7 @@ impl ObvhsBvh {
         // Boxes are padded by four spawn offsets: rays start that close to a face, and the
         // f32 slab test (after CWBVH quantization) must never cull the face they are about
         // to hit. Found by the hit-for-hit test against brute force.
-        let pad = 4.0 * crate::scene::spawn_epsilon(mesh.bounds().max_abs_coordinate()) as f32;
+        let pad = 4.0 * crate::geometry::spawn_epsilon(mesh.bounds().max_abs_coordinate()) as f32;
         let prims: Vec<PaddedTriangle> = (0..mesh.len() as u32)
             .map(|p| padded_box(&mesh, p, pad))
             .collect();

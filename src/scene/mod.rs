@@ -14,7 +14,7 @@ mod solids;
 
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
-use crate::geometry::{Aabb, Mesh};
+use crate::geometry::{Aabb, Mesh, spawn_epsilon};
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
 use crate::rng::PhotonRng;
@@ -168,7 +168,7 @@ impl Scene {
     /// The start of a ray leaving a surface at `point` (unit `normal`) along `dir`:
     /// nudged off the surface to the side `dir` goes. One rule for all backends.
     pub fn spawn_point(&self, point: DVec3, normal: DVec3, dir: DVec3) -> DVec3 {
-        point + normal * self.spawn_eps.copysign(dir.dot(normal))
+        crate::geometry::spawn_origin(point, normal, dir, self.spawn_eps)
     }
 
     /// A Beer-Lambert free path (mm) in `medium`; infinite in a lossless medium.
@@ -302,12 +302,6 @@ impl Fnv1a {
 
 /// Largest vertex coordinate (mm) a geometry file may have after scale and translate.
 pub const MAX_COORDINATE: f64 = 1e12;
-
-/// The spawn offset for a scene whose coordinates reach `extent` mm: a few f32 ulps
-/// there, so single-precision backends never re-hit the surface a ray leaves.
-pub fn spawn_epsilon(extent: f64) -> f64 {
-    16.0 * f32::EPSILON as f64 * extent.max(1.0)
-}
 
 fn default_name(path: &Path) -> String {
     path.parent()

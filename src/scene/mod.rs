@@ -9,6 +9,7 @@
 //!   from the file's origin (outputs are in detector coordinates, so nothing changes).
 
 pub mod config;
+mod hash;
 pub mod meshio;
 mod solids;
 
@@ -59,6 +60,8 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Per medium: its convex solid when the fast path applies (see [`ConvexSolid`]).
     pub convex: Vec<Option<ConvexSolid>>,
+    /// Hash of the scene file's physics sections and the tables they name.
+    file_hash: u64,
 }
 
 impl Scene {
@@ -125,6 +128,7 @@ impl Scene {
             spawn_eps: 0.0,
             warnings,
             convex: Vec::new(),
+            file_hash: hash::file_hash(file, path)?,
         };
         scene.recenter();
         scene.convex = convex_solids(&scene);
@@ -181,25 +185,11 @@ impl Scene {
         }
     }
 
-    /// A 64-bit FNV-1a hash of everything that decides the physics: geometry, tags,
-    /// surface models, media, sources, detector and bounce cap (not the name, path or
-    /// defaults). Shards of one run must agree on it.
+    /// A 64-bit hash of everything that decides the physics, over canonical serialized
+    /// data (see [`hash`]): not the name, path or defaults. Shards of one run must agree
+    /// on it.
     pub fn content_hash(&self) -> u64 {
-        let mut h = Fnv1a::default();
-        for p in &self.mesh.positions {
-            p.to_array().iter().for_each(|c| h.write(&c.to_le_bytes()));
-        }
-        for (t, tag) in self.mesh.triangles.iter().zip(&self.mesh.tri_tag) {
-            t.iter()
-                .chain(std::iter::once(tag))
-                .for_each(|i| h.write(&i.to_le_bytes()));
-        }
-        let physics = format!(
-            "{:?}{:?}{:?}{:?}{:?}{}",
-            self.tags, self.surfaces, self.media, self.sources, self.detector, self.max_bounces
-        );
-        h.write(physics.as_bytes());
-        h.0
+        hash::content_hash(self.file_hash, &self.mesh)
     }
 
     /// Split every triangle of `tag` into `4^levels` (edge midpoints): the same surface
@@ -281,23 +271,6 @@ fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
             (!others_inside && !detector_inside).then_some(solid)
         })
         .collect()
-}
-
-/// 64-bit FNV-1a.
-struct Fnv1a(u64);
-
-impl Default for Fnv1a {
-    fn default() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-}
-
-impl Fnv1a {
-    fn write(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
 }
 
 /// Largest vertex coordinate (mm) a geometry file may have after scale and translate.

@@ -1,6 +1,5 @@
 //! The command line as a user meets it: the report of a short run, and bad input.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn blutrace(args: &[&str]) -> Output {
@@ -10,15 +9,18 @@ fn blutrace(args: &[&str]) -> Output {
         .expect("run blutrace")
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("blutrace-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+/// A fresh temporary folder, removed on drop.
+fn tmp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("blutrace-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
 fn a_run_too_short_for_jackknife_errors_says_so() {
-    let out = tmp("short");
+    let dir = tmp("short");
+    let out = dir.path().join("out");
     let run = blutrace(&[
         "trace",
         "scenes/phone-led",
@@ -33,13 +35,12 @@ fn a_run_too_short_for_jackknife_errors_says_so() {
     assert!(!text.contains("NaN"), "{text}");
     assert!(text.contains("cv ") && text.contains("± n/a"), "{text}");
     assert!(text.contains("need at least 8192 photons"), "{text}");
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
 fn a_bad_scene_names_file_and_field_and_writes_nothing() {
-    let dir = tmp("bad");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tmp("bad");
+    let dir = tmp.path();
     let scene = std::fs::read_to_string("scenes/phone-led/scene.toml").unwrap();
     let bad = scene.replacen("pitch_mm = 0.3", "pitch_mm = -0.3", 1);
     assert_ne!(bad, scene);
@@ -63,5 +64,4 @@ fn a_bad_scene_names_file_and_field_and_writes_nothing() {
     );
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists(), "no output for a scene that does not load");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -352,7 +352,7 @@ fn dots_of(scene: &Scene) -> &DotPattern {
         .expect("the scene has a dots surface")
 }
 
-fn small_scene(name: &str, density: &str) -> std::path::PathBuf {
+fn small_scene(name: &str, density: &str) -> support::SceneDir {
     let obj = box_obj(
         [-20.0, -5.0, -0.5],
         [20.0, 5.0, 0.5],
@@ -472,7 +472,8 @@ fn small_options(method: Method) -> OptimizeOptions {
 
 #[test]
 fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
-    let scene = load(&small_scene("opt-small", "density = [0.3]"));
+    let dir = small_scene("opt-small", "density = [0.3]");
+    let scene = load(&dir);
     for method in [Method::NelderMead, Method::Feedback] {
         let opts = small_options(method);
         let mut lines = Vec::new();
@@ -510,9 +511,11 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
             frac >= min * 0.999 && frac <= max
         }));
         // The written scene traces as it is, with the new density.
-        let out =
-            std::env::temp_dir().join(format!("blutrace-opt-out-{}-{method}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&out);
+        let tmp = tempfile::Builder::new()
+            .prefix(&format!("blutrace-opt-out-{method}-"))
+            .tempdir()
+            .unwrap();
+        let out = tmp.path().join("out");
         let files = r.write(&out).unwrap();
         for f in [
             "optimized.toml",
@@ -543,13 +546,13 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
         assert_eq!(d.density, r.final_density);
         let csv = std::fs::read_to_string(out.join("dots.csv")).unwrap();
         assert_eq!(export::parse_csv(&csv).unwrap().len(), r.dots.len());
-        let _ = std::fs::remove_dir_all(&out);
     }
 }
 
 #[test]
 fn infeasible_designs_are_penalized_not_traced() {
-    let scene = load(&small_scene("opt-infeasible", "density = [0.3]"));
+    let dir = small_scene("opt-infeasible", "density = [0.3]");
+    let scene = load(&dir);
     let opts = OptimizeOptions {
         photons: 5_000,
         max_iter: 6,
@@ -773,12 +776,14 @@ fn feedback_2d_beats_1d_on_phone_led() {
         "band: initial {b0:.4} ± {f0:.4}, 2-D {b2:.4} ± {f2:.4}"
     );
     // The written scene carries the grid as it is, and the grid gets its own map.
-    let out = std::env::temp_dir().join(format!("blutrace-opt-2d-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let tmp = tempfile::Builder::new()
+        .prefix("blutrace-opt-2d-")
+        .tempdir()
+        .unwrap();
+    let out = tmp.path().join("out");
     two.write(&out).unwrap();
     assert!(out.join("density_map.png").is_file());
     let again = load(&out.join("optimized.toml"));
     let reloaded = dots_of(&again);
     assert_eq!(reloaded.density, two.final_density);
-    std::fs::remove_dir_all(&out).unwrap();
 }

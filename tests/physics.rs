@@ -104,7 +104,7 @@ fn fresnel_roulette_matches_closed_form_at_every_angle() {
 
 /// A 20 x 20 x 1 mm PMMA slab whose faces are lossless dielectric; its four side edges
 /// open onto an index-matched black medium, so photons reaching them are absorbed.
-fn slab_scene(name: &str, sources: &str) -> std::path::PathBuf {
+fn slab_scene(name: &str, sources: &str) -> SceneDir {
     let obj = box_obj(
         [-10.0, -10.0, -0.5],
         [10.0, 10.0, 0.5],

@@ -1,6 +1,6 @@
 //! Sharded runs as separate processes, merged, equal one process bit for bit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 const SCENE: &str = "scenes/notebook14";
@@ -22,10 +22,12 @@ fn ok(args: &[&str]) {
     );
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("blutrace-shards-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+/// A fresh temporary folder, removed on drop.
+fn tmp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("blutrace-shards-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn shard(dir: &Path, k: usize, m: usize, seed: &str) -> String {
@@ -67,7 +69,8 @@ fn summary_without_timing(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn four_shards_merge_to_the_single_run_bit_for_bit() {
-    let dir = tmp("equal");
+    let tmp = tmp("equal");
+    let dir = tmp.path();
     let single = dir.join("single");
     ok(&[
         "trace",
@@ -80,7 +83,7 @@ fn four_shards_merge_to_the_single_run_bit_for_bit() {
         "--out",
         single.to_str().unwrap(),
     ]);
-    let shards: Vec<String> = (0..4).map(|k| shard(&dir, k, 4, "5")).collect();
+    let shards: Vec<String> = (0..4).map(|k| shard(dir, k, 4, "5")).collect();
     let merged = dir.join("merged");
     let mut args: Vec<&str> = vec!["merge"];
     args.extend(shards.iter().rev().map(String::as_str)); // order must not matter
@@ -102,9 +105,10 @@ fn four_shards_merge_to_the_single_run_bit_for_bit() {
 
 #[test]
 fn missing_duplicate_and_foreign_shards_are_errors() {
-    let dir = tmp("bad");
-    let s0 = shard(&dir, 0, 3, "9");
-    let s1 = shard(&dir, 1, 3, "9");
+    let tmp_dir = tmp("bad");
+    let dir = tmp_dir.path();
+    let s0 = shard(dir, 0, 3, "9");
+    let s1 = shard(dir, 1, 3, "9");
     let out = dir.join("m");
     let out = out.to_str().unwrap();
     let err = blutrace(&["merge", &s0, &s1, "--out", out]);
@@ -124,7 +128,7 @@ fn missing_duplicate_and_foreign_shards_are_errors() {
     let dup = blutrace(&["merge", &s0, &s0, "--out", out]);
     assert!(String::from_utf8_lossy(&dup.stderr).contains("given twice"));
     let other_dir = tmp("other");
-    let foreign = shard(&other_dir, 2, 3, "10");
+    let foreign = shard(other_dir.path(), 2, 3, "10");
     let mixed = blutrace(&["merge", &s0, &s1, &foreign, "--out", out]);
     assert!(
         String::from_utf8_lossy(&mixed.stderr).contains("seed is 10"),

@@ -225,24 +225,16 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    /// A unique file path under the system temp dir, removed on drop.
-    struct TempFile(PathBuf);
+    /// A path (not yet a file) in a fresh temporary folder, removed on drop.
+    struct TempFile(PathBuf, #[allow(dead_code)] tempfile::TempDir);
 
     impl TempFile {
         fn new(tag: &str) -> Self {
-            use std::sync::atomic::{AtomicU32, Ordering};
-            static N: AtomicU32 = AtomicU32::new(0);
-            let n = N.fetch_add(1, Ordering::Relaxed);
-            Self(
-                std::env::temp_dir()
-                    .join(format!("blutrace-exr-{tag}-{}-{n}.exr", std::process::id())),
-            )
-        }
-    }
-
-    impl Drop for TempFile {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
+            let dir = tempfile::Builder::new()
+                .prefix(&format!("blutrace-exr-{tag}-"))
+                .tempdir()
+                .unwrap();
+            Self(dir.path().join("file.exr"), dir)
         }
     }
 

@@ -296,23 +296,16 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    struct TempFile(PathBuf);
+    /// A path (not yet a file) in a fresh temporary folder, removed on drop.
+    struct TempFile(PathBuf, #[allow(dead_code)] tempfile::TempDir);
 
     impl TempFile {
         fn new(tag: &str) -> Self {
-            use std::sync::atomic::{AtomicU32, Ordering};
-            static N: AtomicU32 = AtomicU32::new(0);
-            let n = N.fetch_add(1, Ordering::Relaxed);
-            Self(
-                std::env::temp_dir()
-                    .join(format!("blutrace-png-{tag}-{}-{n}.png", std::process::id())),
-            )
-        }
-    }
-
-    impl Drop for TempFile {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
+            let dir = tempfile::Builder::new()
+                .prefix(&format!("blutrace-png-{tag}-"))
+                .tempdir()
+                .unwrap();
+            Self(dir.path().join("file.png"), dir)
         }
     }
 

@@ -36,18 +36,39 @@ pub fn box_obj(min: [f64; 3], max: [f64; 3], tags: [&str; 6]) -> String {
     s
 }
 
-/// Write a scene (scene.toml plus named files) into a fresh temporary folder and
-/// return the scene file's path.
-pub fn write_scene(name: &str, toml: &str, files: &[(&str, &str)]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("blutrace-test-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    for (f, text) in files {
-        std::fs::write(dir.join(f), text).unwrap();
+/// A scene written to a temporary folder: derefs to the scene file's path; the folder is
+/// removed when this is dropped.
+pub struct SceneDir {
+    path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+impl std::ops::Deref for SceneDir {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        &self.path
     }
-    let path = dir.join("scene.toml");
+}
+
+impl AsRef<Path> for SceneDir {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Write a scene (scene.toml plus named files) into a fresh temporary folder.
+pub fn write_scene(name: &str, toml: &str, files: &[(&str, &str)]) -> SceneDir {
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("blutrace-test-{name}-"))
+        .tempdir()
+        .unwrap();
+    for (f, text) in files {
+        std::fs::write(dir.path().join(f), text).unwrap();
+    }
+    let path = dir.path().join("scene.toml");
     std::fs::write(&path, toml).unwrap();
-    path
+    SceneDir { path, _dir: dir }
 }
 
 /// Load a scene written by [`write_scene`], panicking with the loader's message.
@@ -159,4 +180,26 @@ pub fn guide_scene(name: &str) -> Scene {
 pub fn chi2_quantile(k: f64, z: f64) -> f64 {
     let a = 2.0 / (9.0 * k);
     k * (1.0 - a + z * a.sqrt()).powi(3)
+}
+
+/// Every `scene.toml` below the crate's `scenes/` folder, sorted: a new bundled scene is
+/// covered without being listed anywhere.
+pub fn bundled_scene_files() -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.file_name().is_some_and(|n| n == "scene.toml") {
+                out.push(p);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+        &mut out,
+    );
+    out.sort();
+    out
 }

@@ -14,7 +14,6 @@
 //! is detected and stops there; one crossing the other way passes through.
 
 use crate::geometry::Ray;
-use crate::tally::Grid;
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -156,14 +155,6 @@ impl TargetPlane {
         let t0 = FRAC_PI_2 * it as f64 / nt as f64;
         let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
         0.5 * (t1.sin().powi(2) - t0.sin().powi(2)) * TAU / np as f64
-    }
-
-    /// Empty flux and angular grids for this detector.
-    pub fn empty_grids(&self) -> (Grid, Grid) {
-        (
-            Grid::new(self.bins[0], self.bins[1]),
-            Grid::new(self.angular_bins[0], self.angular_bins[1]),
-        )
     }
 }
 

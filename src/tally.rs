@@ -333,10 +333,10 @@ pub struct Tally {
 impl Tally {
     /// An empty tally shaped for `scene`.
     pub fn new(scene: &Scene) -> Self {
-        let (flux, angular) = scene.detector.empty_grids();
+        let d = &scene.detector;
         Self {
-            flux,
-            angular,
+            flux: Grid::new(d.bins[0], d.bins[1]),
+            angular: Grid::new(d.angular_bins[0], d.angular_bins[1]),
             ledger: Ledger::new(scene.tags.len(), scene.media.len()),
         }
     }

@@ -1,12 +1,12 @@
 //! False-colour PNG previews of 2D grids, for people to look at.
 //!
 //! [`write_false_colour`] maps each grid value through the perceptually uniform *viridis*
-//! colour map ([`viridis`](super::colormap::viridis)), enlarges every bin to an integer
-//! number of pixels (so the longer side of the map is about 600–800 pixels), puts grid row
-//! 0 at the bottom (`y` up) and draws a vertical colour bar on the right labelled with its
-//! minimum, middle and maximum values (the built-in 5×7 pixel font of
-//! [`font`](super::font)). Bins without a meaningful value (NaN, infinite, or negative
-//! when the range starts at zero or above) are drawn grey.
+//! colour map ([`viridis`]), enlarges every bin to an integer number of pixels (so the
+//! longer side of the map is about 600–800 pixels), puts grid row 0 at the bottom (`y` up)
+//! and draws a vertical colour bar on the right labelled with its minimum, middle and
+//! maximum values (the built-in 5×7 pixel font of the `font` module). Bins without a
+//! meaningful value (NaN, infinite, or negative when the range starts at zero or above)
+//! are drawn grey.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

@@ -186,8 +186,8 @@ impl Scene {
     }
 
     /// A 64-bit hash of everything that decides the physics, over canonical serialized
-    /// data (see [`hash`]): not the name, path or defaults. Shards of one run must agree
-    /// on it.
+    /// data (see the `hash` module): not the name, path or defaults. Shards of one run
+    /// must agree on it.
     pub fn content_hash(&self) -> u64 {
         hash::content_hash(self.file_hash, &self.mesh)
     }

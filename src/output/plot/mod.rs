@@ -3,7 +3,7 @@
 //! [`write_chart`] draws a [`Chart`] — a few [`Series`] of `(x, y)` points — as an
 //! 800×560 pixel PNG: white background, a framed plot area with light grid lines, numeric
 //! tick labels, axis labels, a title and a legend, all written with the built-in 5×7 pixel
-//! font of [`super::font`]. Each axis is linear or logarithmic ([`Scale`]); its range is
+//! font of the `font` module. Each axis is linear or logarithmic ([`Scale`]); its range is
 //! chosen automatically from the data with a small margin.
 //!
 //! - Linear axes get about 5 (3–7) "nice" ticks: multiples of 1, 2, 2.5 or 5 times a power

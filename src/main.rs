@@ -47,6 +47,10 @@ enum Command {
     Check {
         /// Scene file (or a folder holding scene.toml).
         scene: PathBuf,
+        /// Write the geometry report (files and tags with triangle counts and bounding
+        /// boxes in mm, after all transforms) and the warnings as JSON on stdout.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -132,7 +136,7 @@ impl Command {
                 scene,
                 repeat,
             } => bench(&scene, photons, threads, repeat),
-            Command::Check { scene } => check(&scene_path(&scene)),
+            Command::Check { scene, json } => check(&scene_path(&scene), json),
         }
     }
 }
@@ -369,14 +373,55 @@ fn bench(scene: &Path, photons: u64, threads: Option<usize>, repeat: usize) -> R
     Ok(())
 }
 
-fn check(path: &Path) -> Result<()> {
+/// "  x from .. to .. mm" for a check line.
+fn bounds(b: Option<blutrace::scene::geometry_report::BoxMm>) -> String {
+    let Some(b) = b else {
+        return String::new();
+    };
+    let size: Vec<String> = (0..3)
+        .map(|i| format!("{:.3}", b.max[i] - b.min[i]))
+        .collect();
+    format!(
+        ", {} mm, from {:.3?} to {:.3?}",
+        size.join(" x "),
+        b.min,
+        b.max
+    )
+}
+
+fn check(path: &Path, json: bool) -> Result<()> {
     let scene = Scene::load(path)?;
+    if json {
+        let report = serde_json::json!({
+            "scene": scene.name,
+            "scene_file": path.display().to_string(),
+            "geometry": scene.geometry,
+            "warnings": scene.warnings,
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
     println!("scene      {} ({})", scene.name, path.display());
     println!(
         "geometry   {} triangles, {} tags",
         scene.mesh.len(),
         scene.tags.len()
     );
+    for g in &scene.geometry {
+        println!(
+            "  file {:<25} {:>8} triangles{}",
+            g.file,
+            g.triangles,
+            bounds(g.bounds_mm)
+        );
+        for (tag, t) in &g.tags {
+            println!(
+                "    tag {tag:<22} {:>8} triangles{}",
+                t.triangles,
+                bounds(Some(t.bounds_mm))
+            );
+        }
+    }
     for ((tag, model), n) in scene
         .tags
         .iter()

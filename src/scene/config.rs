@@ -4,9 +4,8 @@
 //! version = 1
 //! name = "notebook14"
 //!
-//! [[geometry]]
+//! [[geometry]]                # see `geometry_file` for units, up axis, rotation, tag
 //! file = "notebook14.obj"    # OBJ (usemtl names, else group/object names, are tags)
-//! scale = 1.0                # optional, applied before translate
 //! translate = [0.0, 0.0, 0.0]
 //!
 //! [media.pmma]
@@ -35,6 +34,7 @@
 //! Sections `[surfaces.*]`, `[[sources]]`, `[detector]` and `[trace]` are documented in
 //! the modules that implement them.
 
+pub use super::geometry_file::GeometrySpec;
 use crate::optics::absorber::AbsorberSpec;
 pub use crate::optics::density::DensityGridSpec;
 use crate::optics::dielectric::DielectricSpec;
@@ -48,7 +48,6 @@ use crate::optics::phong::PhongSpec;
 pub use crate::sources::SourceSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
 /// The only scene-file version this build reads.
 pub const SCENE_VERSION: u32 = 1;
@@ -77,24 +76,6 @@ pub struct SceneFile {
     /// Tracing defaults.
     #[serde(default)]
     pub trace: TraceSpec,
-}
-
-/// One geometry file and its placement.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct GeometrySpec {
-    /// Path to an `.obj`, `.gltf` or `.glb` file.
-    pub file: PathBuf,
-    /// Uniform scale to millimetres.
-    #[serde(default = "one")]
-    pub scale: f64,
-    /// Translation (mm), applied after scaling.
-    #[serde(default)]
-    pub translate: [f64; 3],
-}
-
-fn one() -> f64 {
-    1.0
 }
 
 /// The optical model of one tag: `model = "..."` picks the model, whose module owns the

@@ -1,9 +1,11 @@
-//! Reading tagged triangles from OBJ and glTF 2.0 files.
+//! Reading tagged triangles from OBJ, glTF 2.0, STL and PLY files.
 //!
 //! Tags: in OBJ the `usemtl` name (whether or not the `.mtl` file exists), else the
-//! `o`/`g` name; in glTF the material name of each primitive. glTF node transforms are
-//! applied. Positions are scaled and translated as the scene file says.
+//! `o`/`g` name; in glTF the material name of each primitive; STL and PLY carry none. A
+//! scene's `tag` replaces them all. glTF node transforms are applied, then the placement
+//! the scene file gives ([`super::geometry_file`]).
 
+use super::geometry_file::Format;
 use anyhow::{Context, Result, bail};
 use glam::{DMat4, DVec3};
 use std::io::BufReader;
@@ -18,6 +20,8 @@ pub struct TaggedTriangles {
     pub triangles: Vec<[u32; 3]>,
     /// Tag per triangle.
     pub tags: Vec<String>,
+    /// The file's own tags, where a scene's `tag` replaced them.
+    pub own_tags: Option<Vec<String>>,
 }
 
 impl TaggedTriangles {
@@ -52,24 +56,34 @@ impl TaggedTriangles {
     }
 }
 
-/// Read a geometry file (by extension), applying `transform` to every position.
-pub fn load(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    match ext.as_str() {
-        "obj" => load_obj(path, transform),
-        "gltf" | "glb" => load_gltf(path, transform),
-        _ => bail!(
-            "{}: unknown geometry format (expected .obj, .gltf or .glb)",
-            path.display()
-        ),
+/// Read a geometry file of `format`, applying `transform` to every position; `tag`, when
+/// given, tags every triangle.
+pub fn load(
+    path: &Path,
+    format: Format,
+    transform: DMat4,
+    tag: Option<&str>,
+) -> Result<TaggedTriangles> {
+    let mut tris = match format {
+        Format::Obj => load_obj(path, transform, tag)?,
+        Format::Gltf => load_gltf(path, transform)?,
+        Format::Stl => load_stl(path, transform)?,
+        Format::Ply => load_ply(path, transform)?,
+    };
+    if let Some(tag) = tag {
+        let mut own: Vec<String> = tris.tags.iter().filter(|t| *t != tag).cloned().collect();
+        own.sort_unstable();
+        own.dedup();
+        tris.own_tags = (!own.is_empty() && !format.untagged()).then_some(own);
+        tris.tags.iter_mut().for_each(|t| *t = tag.to_string());
     }
+    Ok(tris)
 }
 
-fn load_obj(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
+/// Untagged triangles read by a format without material names (tagged by the caller).
+const UNTAGGED: &str = "";
+
+fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTriangles> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
     // Material names become tags even when the .mtl file is missing: hand tobj a
@@ -99,11 +113,13 @@ fn load_obj(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
     for m in &models {
         let tag = match m.mesh.material_id {
             Some(i) => materials[i].name.clone(),
+            None if m.name == "unnamed_object" => tag.unwrap_or_default().to_string(),
             None => m.name.clone(),
         };
-        if tag.is_empty() || tag == "unnamed_object" {
+        if tag.is_empty() {
             bail!(
-                "{}: faces with neither `usemtl` nor an `o`/`g` name: cannot tag them",
+                "{}: faces with neither `usemtl` nor an `o`/`g` name: cannot tag them (give the \
+                 geometry a `tag`)",
                 path.display()
             );
         }
@@ -190,4 +206,98 @@ fn add_primitive(
         None => (0..positions.len() as u32).collect(),
     };
     out.push_indexed(&positions, &indices, tag, path)
+}
+
+fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(&bytes))
+        .map_err(|e| anyhow::anyhow!("{}: not a valid STL file: {e}", path.display()))?;
+    if mesh.faces.is_empty() {
+        bail!("{}: the STL file holds no triangles", path.display());
+    }
+    let positions: Vec<DVec3> = mesh
+        .vertices
+        .iter()
+        .map(|v| transform.transform_point3(DVec3::from_array(v.0.map(f64::from))))
+        .collect();
+    let indices: Vec<u32> = mesh
+        .faces
+        .iter()
+        .flat_map(|f| f.vertices.map(|i| i as u32))
+        .collect();
+    let mut out = TaggedTriangles::default();
+    out.push_indexed(&positions, &indices, UNTAGGED, path)?;
+    Ok(out)
+}
+
+fn load_ply(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
+    use ply_rs_bw::{parser::Parser, ply::DefaultElement};
+    let file =
+        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut BufReader::new(file))
+        .map_err(|e| anyhow::anyhow!("{}: not a valid PLY file: {e}", path.display()))?;
+    let element = |name: &str| ply.payload.get(name).map(Vec::as_slice).unwrap_or_default();
+    let positions = element("vertex")
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let c = |axis: &str| {
+                ply_number(v.get(axis)).with_context(|| {
+                    format!("{}: vertex {k} has no number `{axis}`", path.display())
+                })
+            };
+            Ok(transform.transform_point3(DVec3::new(c("x")?, c("y")?, c("z")?)))
+        })
+        .collect::<Result<Vec<DVec3>>>()?;
+    let mut indices = Vec::new();
+    for (k, f) in element("face").iter().enumerate() {
+        let list = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .and_then(ply_indices)
+            .with_context(|| format!("{}: face {k} has no vertex_indices list", path.display()))?;
+        if list.len() < 3 {
+            bail!("{}: face {k} has {} vertices", path.display(), list.len());
+        }
+        // A fan triangulates the convex polygons exporters write.
+        for j in 1..list.len() - 1 {
+            indices.extend([list[0], list[j], list[j + 1]]);
+        }
+    }
+    if indices.is_empty() {
+        bail!("{}: the PLY file holds no faces", path.display());
+    }
+    let mut out = TaggedTriangles::default();
+    out.push_indexed(&positions, &indices, UNTAGGED, path)?;
+    Ok(out)
+}
+
+fn ply_number(p: Option<&ply_rs_bw::ply::Property>) -> Option<f64> {
+    use ply_rs_bw::ply::Property as P;
+    Some(match p? {
+        P::Float(x) => f64::from(*x),
+        P::Double(x) => *x,
+        P::Char(x) => f64::from(*x),
+        P::UChar(x) => f64::from(*x),
+        P::Short(x) => f64::from(*x),
+        P::UShort(x) => f64::from(*x),
+        P::Int(x) => f64::from(*x),
+        P::UInt(x) => f64::from(*x),
+        _ => return None,
+    })
+}
+
+fn ply_indices(p: &ply_rs_bw::ply::Property) -> Option<Vec<u32>> {
+    use ply_rs_bw::ply::Property as P;
+    let signed = |v: Vec<i64>| v.into_iter().map(|i| u32::try_from(i).ok()).collect();
+    match p {
+        P::ListInt(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
+        P::ListShort(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
+        P::ListChar(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
+        P::ListUInt(v) => Some(v.clone()),
+        P::ListUShort(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
+        P::ListUChar(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
+        _ => None,
+    }
 }

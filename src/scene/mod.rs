@@ -9,6 +9,8 @@
 //!   from the file's origin (outputs are in detector coordinates, so nothing changes).
 
 pub mod config;
+pub mod geometry_file;
+pub mod geometry_report;
 mod hash;
 pub mod meshio;
 mod solids;
@@ -23,7 +25,8 @@ use crate::sources::Sources;
 use crate::spec_check::Ctx;
 use anyhow::{Context, Result};
 use config::{DetectorSpec, SceneFile, SurfaceSpec};
-use glam::{DMat4, DVec3};
+use geometry_report::GeometryReport;
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -58,6 +61,8 @@ pub struct Scene {
     pub spawn_eps: f64,
     /// Non-fatal findings of loading, for the user.
     pub warnings: Vec<String>,
+    /// What each geometry file contributed, in the scene file's frame (for `check`).
+    pub geometry: Vec<GeometryReport>,
     /// Per medium: its convex solid when the fast path applies (see [`ConvexSolid`]).
     pub convex: Vec<Option<ConvexSolid>>,
     /// Hash of the scene file's physics sections and the tables they name.
@@ -90,7 +95,7 @@ impl Scene {
         }
         let mut warnings = Vec::new();
         let media = medium::build_media(&ctx, &file.media)?;
-        let (mut mesh, tags) = load_geometry(&ctx, file, path, &mut warnings)?;
+        let (mut mesh, tags, geometry) = load_geometry(&ctx, file, path, &mut warnings)?;
         let mut surfaces = Vec::with_capacity(tags.len());
         for tag in &tags {
             let spec = file
@@ -127,10 +132,12 @@ impl Scene {
             offset: DVec3::ZERO,
             spawn_eps: 0.0,
             warnings,
+            geometry,
             convex: Vec::new(),
             file_hash: hash::file_hash(file, path)?,
         };
         scene.recenter();
+        scene.warnings.extend(placement_warnings(&scene));
         scene.convex = convex_solids(&scene);
         Ok(scene)
     }
@@ -240,6 +247,21 @@ impl Scene {
     }
 }
 
+/// Parts cut by the detector plane or by a lamp's emitting surface (positions in the
+/// scene file's frame).
+fn placement_warnings(scene: &Scene) -> Vec<String> {
+    let (mesh, tags, eps) = (&scene.mesh, &scene.tags, scene.spawn_eps);
+    let mut w = geometry_report::detector_cuts(mesh, tags, &scene.detector, eps, scene.offset);
+    w.extend(geometry_report::source_cuts(
+        mesh,
+        tags,
+        &scene.sources.list,
+        eps,
+        scene.offset,
+    ));
+    w
+}
+
 /// For each medium, the convex solid enclosing it when the fast path is safe: exactly one
 /// closed convex component, and no other triangle and no detector corner inside it.
 fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
@@ -288,14 +310,12 @@ fn load_geometry(
     file: &SceneFile,
     path: &Path,
     warnings: &mut Vec<String>,
-) -> Result<(Mesh, Vec<String>)> {
+) -> Result<(Mesh, Vec<String>, Vec<GeometryReport>)> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut tags: Vec<String> = Vec::new();
     let mut mesh = Mesh::default();
+    let mut reports = Vec::new();
     for (i, g) in file.geometry.iter().enumerate() {
-        let scale = ctx.positive(&format!("geometry[{i}].scale"), g.scale)?;
-        let shift = ctx.point(&format!("geometry[{i}].translate"), g.translate)?;
-        let transform = DMat4::from_translation(shift) * DMat4::from_scale(DVec3::splat(scale));
         let gpath = dir.join(&g.file);
         if !gpath.exists() {
             return Err(ctx.err(
@@ -303,7 +323,7 @@ fn load_geometry(
                 format!("{} does not exist", gpath.display()),
             ));
         }
-        let tris = meshio::load(&gpath, transform)?;
+        let tris = g.load(ctx, i, &gpath, warnings)?;
         // NaN or infinite vertices would poison the bounds, the recentring and the f32
         // backends (a panic in the BVH build); beyond 1e12 mm f64 resolves no better than
         // 0.1 mm: a unit or export error either way.
@@ -316,7 +336,7 @@ fn load_geometry(
             return Err(ctx.err(
                 &format!("geometry[{i}].file"),
                 format!(
-                    "{}: vertex {k} is at ({:?}, {:?}, {:?}) mm after scale and translate; coordinates must be finite and within {MAX_COORDINATE:e} mm",
+                    "{}: vertex {k} is at ({:?}, {:?}, {:?}) mm after units, scale, rotation and translate; coordinates must be finite and within {MAX_COORDINATE:e} mm",
                     gpath.display(),
                     p.x,
                     p.y,
@@ -325,6 +345,7 @@ fn load_geometry(
             ));
         }
         let base = mesh.positions.len() as u32;
+        let first = mesh.triangles.len();
         mesh.positions.extend(&tris.positions);
         let mut dropped = 0;
         for (t, tag) in tris.triangles.iter().zip(&tris.tags) {
@@ -359,8 +380,14 @@ fn load_geometry(
                 gpath.display()
             ));
         }
+        let kept: Vec<([u32; 3], &str)> = (first..mesh.triangles.len())
+            .map(|k| (mesh.triangles[k], tags[mesh.tri_tag[k] as usize].as_str()))
+            .collect();
+        let report = GeometryReport::new(g.file.display().to_string(), &mesh, &kept);
+        warnings.extend(report.extent_warning());
+        reports.push(report);
     }
-    Ok((mesh, tags))
+    Ok((mesh, tags, reports))
 }
 
 /// Check a surface entry and build its model (each model checks its own fields).

@@ -20,15 +20,15 @@ curve is cut into SEGMENTS equal steps of the polar angle about the focus (fines
 vertex, where it is closest to the lamp); everything is triangulated before export so
 both files hold the same triangles.
 
-Conventions: Blender units are metres, glTF's unit: scene.toml loads the glTF with
-`scale = 1000.0`. The OBJ exporter writes 6 decimals, a micrometre in metres, so the OBJ
-is written in millimetres (global_scale = 1000) and scene-obj.toml loads it unscaled.
-The model is built in the scene's own axes (z up = towards the
-viewer), so the exporters' usual Z-up to Y-up conversion is switched off (glTF
-export_yup=False; OBJ forward_axis='Y', up_axis='Z', the identity). The object's origin
-is on the lamp axis at mid-length (x_f, W/2, z_c): the glTF node carries that
-translation and its vertices are relative to it; the OBJ exporter writes world
-coordinates.
+Conventions: the glTF file is exported with Blender's defaults, as a user would: metres
+(Blender's unit and glTF's) and +Y up (Blender turns its Z-up model so that its +Z becomes
+glTF's +Y), so scene.toml loads it with blutrace's glTF defaults (units = "m", up = "y")
+and no scale or rotation. The OBJ exporter writes 6 decimals, a micrometre in metres, so
+the OBJ is written in millimetres (global_scale = 1000) in the model's own axes (z up =
+towards the viewer; forward_axis='Y', up_axis='Z', the identity) and scene-obj.toml loads
+it with the OBJ defaults (mm, z up). The object's origin is on the lamp axis at
+mid-length (x_f, W/2, z_c): the glTF node carries that translation and its vertices are
+relative to it; the OBJ exporter writes world coordinates.
 """
 
 import math
@@ -132,7 +132,6 @@ def main():
     bpy.ops.export_scene.gltf(
         filepath=os.path.join(out, "reflector.gltf"),
         export_format="GLTF_SEPARATE",
-        export_yup=False,
         export_apply=True,
         export_normals=False,
         export_texcoords=False,

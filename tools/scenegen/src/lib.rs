@@ -453,11 +453,18 @@ pub fn tags_of(parts: &[Part]) -> Vec<&str> {
     tags
 }
 
+/// World millimetres, z up, to glTF's metres, y up.
+fn gltf_frame(p: P3) -> P3 {
+    [p[0] / 1000.0, p[2] / 1000.0, -p[1] / 1000.0]
+}
+
 /// A glTF 2.0 file (`.gltf` JSON plus a separate `.bin` buffer named `bin_name`): one
 /// root node named `root` with translation `translation`, one child node and mesh per
 /// part, one primitive per tag (all primitives of a mesh share its POSITION accessor),
-/// one material per tag. Part vertices are in world coordinates; the file stores them
-/// relative to the root node, so the node transform must be applied to read them back.
+/// one material per tag. Part vertices are in world coordinates (millimetres, z up); the
+/// file stores them as the glTF specification says, in metres with +y up (world (x, y, z)
+/// is glTF (x, z, -y), as Blender exports), relative to the root node, so the node
+/// transform must be applied to read them back.
 pub fn write_gltf(
     scene_name: &str,
     root: &str,
@@ -474,7 +481,7 @@ pub fn write_gltf(
         let local: Vec<[f32; 3]> = part
             .verts
             .iter()
-            .map(|v| [0, 1, 2].map(|k| r6(v[k] - translation[k]) as f32))
+            .map(|v| gltf_frame([0, 1, 2].map(|k| r6(v[k] - translation[k]))).map(|c| c as f32))
             .collect();
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
@@ -544,7 +551,7 @@ pub fn write_gltf(
     let children: Vec<String> = (1..=parts.len()).map(|i| i.to_string()).collect();
     let mut nodes = vec![format!(
         "{{\"name\": \"{root}\", \"translation\": {}, \"children\": [{}]}}",
-        arr(&translation),
+        arr(&gltf_frame(translation)),
         children.join(", ")
     )];
     for (i, part) in parts.iter().enumerate() {

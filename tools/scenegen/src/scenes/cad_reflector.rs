@@ -5,10 +5,10 @@
 //! per export:
 //!
 //! ```toml
-//! # scene.toml: the glTF export, in metres
+//! # scene.toml: the glTF export with Blender's defaults (metres, +y up), which are
+//! # also blutrace's glTF defaults: no scale, no rotation
 //! [[geometry]]
 //! file = "reflector.gltf"
-//! scale = 1000.0
 //!
 //! # scene-obj.toml: the OBJ export, written in millimetres
 //! [[geometry]]
@@ -108,9 +108,10 @@ fn scene_toml(obj: bool, triangles: usize) -> String {
         )
     } else {
         (
-            "the glTF export (reflector.gltf + .bin, in metres as glTF specifies)",
+            "the glTF export (reflector.gltf + .bin, Blender's defaults: metres and +y up, as \
+             glTF specifies and blutrace reads glTF by default)",
             "reflector.gltf",
-            "scale = 1000.0\n",
+            "",
         )
     };
     let other = if obj { "scene.toml" } else { "scene-obj.toml" };

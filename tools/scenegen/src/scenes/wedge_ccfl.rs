@@ -139,9 +139,11 @@ no wedge design; every dimension here is chosen as typical (lengths in mm):
   Phong: reflectance 0.95, specular 0.1, exponent 10.
 - Detector: {DETECTOR_GAP} above the front face (z = {zd}), exactly covering it.
 
-Geometry: wedge-ccfl.gltf + wedge-ccfl.bin (tags are material names), {triangles} triangles.
-The glTF root node \"blu\" is translated by {tr}: the file's vertices are relative to
-it, and this file's coordinates are world coordinates.
+Geometry: wedge-ccfl.gltf + wedge-ccfl.bin (tags are material names), {triangles} triangles,
+written as the glTF specification says (metres, +y up), so it loads with the glTF defaults
+units = \"m\", up = \"y\". The glTF root node \"blu\" is translated by {tr} mm (in the
+file's own frame): the file's vertices are relative to it, and this file's coordinates
+are world coordinates in millimetres, z up.
 ",
         zb = dim(back_z(L)),
         rise = dim(T0 - T1),

@@ -1,0 +1,225 @@
+//! What each geometry file put into the scene, for `blutrace check`: triangles and
+//! bounding boxes in millimetres after all transforms, per file and per tag, and the
+//! placement warnings that catch unit and axis mistakes (a part 1000x too large or small,
+//! a lamp or the detector plane cutting through a part).
+
+use crate::detector::TargetPlane;
+use crate::geometry::Mesh;
+use crate::sources::{Emitter, Source};
+use glam::DVec3;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Smallest and largest plausible extent of a backlight part (mm): outside, "check units".
+pub const PLAUSIBLE_EXTENT_MM: (f64, f64) = (0.01, 5000.0);
+
+/// An axis-aligned box in scene millimetres (the scene file's frame).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BoxMm {
+    /// Smallest corner.
+    pub min: [f64; 3],
+    /// Largest corner.
+    pub max: [f64; 3],
+}
+
+impl BoxMm {
+    fn of(points: impl Iterator<Item = DVec3>) -> Option<BoxMm> {
+        let (lo, hi) = points.fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+        (lo.x <= hi.x).then(|| BoxMm {
+            min: lo.to_array(),
+            max: hi.to_array(),
+        })
+    }
+
+    /// The largest side (mm).
+    pub fn extent(&self) -> f64 {
+        (0..3)
+            .map(|i| self.max[i] - self.min[i])
+            .fold(0.0, f64::max)
+    }
+}
+
+/// One tag's share of a file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TagReport {
+    /// Triangles kept (zero-area ones dropped).
+    pub triangles: usize,
+    /// Their bounding box.
+    pub bounds_mm: BoxMm,
+}
+
+/// One geometry file as loaded.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GeometryReport {
+    /// The file, as the scene names it.
+    pub file: String,
+    /// Triangles kept.
+    pub triangles: usize,
+    /// Bounding box of its triangles (None when every triangle was dropped).
+    pub bounds_mm: Option<BoxMm>,
+    /// Per tag.
+    pub tags: BTreeMap<String, TagReport>,
+}
+
+impl GeometryReport {
+    /// The report of `file`'s triangles `tris` (indices into `mesh`) with their tag names.
+    pub fn new(file: String, mesh: &Mesh, tris: &[([u32; 3], &str)]) -> Self {
+        let corners = |sel: &dyn Fn(&str) -> bool| {
+            let pts: Vec<DVec3> = tris
+                .iter()
+                .filter(|(_, tag)| sel(tag))
+                .flat_map(|(t, _)| t.map(|v| mesh.positions[v as usize]))
+                .collect();
+            pts
+        };
+        let mut tags = BTreeMap::new();
+        for (_, tag) in tris {
+            if tags.contains_key(*tag) {
+                continue;
+            }
+            let pts = corners(&|t| t == *tag);
+            let bounds_mm = BoxMm::of(pts.iter().copied()).expect("a tag has triangles");
+            let triangles = pts.len() / 3;
+            tags.insert(
+                tag.to_string(),
+                TagReport {
+                    triangles,
+                    bounds_mm,
+                },
+            );
+        }
+        GeometryReport {
+            file,
+            triangles: tris.len(),
+            bounds_mm: BoxMm::of(corners(&|_| true).into_iter()),
+            tags,
+        }
+    }
+
+    /// A warning when the file's extent is implausible for a backlight part.
+    pub fn extent_warning(&self) -> Option<String> {
+        let e = self.bounds_mm?.extent();
+        let (lo, hi) = PLAUSIBLE_EXTENT_MM;
+        (e < lo || e > hi).then(|| {
+            format!(
+                "{}: the part is {e:.4e} mm across, outside {lo}..{hi} mm for a backlight \
+                 part: check units (and scale)",
+                self.file
+            )
+        })
+    }
+}
+
+/// Warnings where the detector plane passes through a triangle inside its rectangle (the
+/// target should lie in air in front of the guide, not cut a part).
+pub fn detector_cuts(
+    mesh: &Mesh,
+    tags: &[String],
+    d: &TargetPlane,
+    eps: f64,
+    offset: DVec3,
+) -> Vec<String> {
+    let n = d.u.cross(d.v);
+    let mut hit = BTreeMap::new();
+    for (p, &tag) in mesh.tri_tag.iter().enumerate() {
+        let c = mesh.corners(p as u32);
+        let s = c.map(|x| n.dot(x - d.origin));
+        if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
+            continue;
+        }
+        let inside = c.iter().any(|x| {
+            let (a, b) = ((*x - d.origin).dot(d.u), (*x - d.origin).dot(d.v));
+            (0.0..=d.size[0]).contains(&a) && (0.0..=d.size[1]).contains(&b)
+        });
+        if inside {
+            hit.entry(tag).or_insert(c[0] + offset);
+        }
+    }
+    hit.into_iter()
+        .map(|(tag, at)| {
+            format!(
+                "the detector plane cuts tag '{}' (near {at:.3?} mm): the target should lie \
+                 in front of the parts",
+                tags[tag as usize]
+            )
+        })
+        .collect()
+}
+
+/// Warnings where a mesh vertex lies inside a CCFL tube, or a triangle crosses an LED's
+/// emitting rectangle: light would be emitted inside a part.
+pub fn source_cuts(
+    mesh: &Mesh,
+    tags: &[String],
+    sources: &[Source],
+    eps: f64,
+    offset: DVec3,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in sources {
+        let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
+        for (p, &tag) in mesh.tri_tag.iter().enumerate() {
+            let c = mesh.corners(p as u32);
+            if cuts_emitter(&s.emitter, c, eps) {
+                hit.entry(tag).or_insert(c[0] + offset);
+            }
+        }
+        out.extend(hit.into_iter().map(|(tag, at)| {
+            format!(
+                "source '{}': its emitting surface cuts tag '{}' (near {at:.3?} mm)",
+                s.name, tags[tag as usize]
+            )
+        }));
+    }
+    out
+}
+
+fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
+    match e {
+        Emitter::Ccfl {
+            center,
+            axis,
+            radius,
+            length,
+        } => c.iter().any(|x| {
+            let rel = *x - *center;
+            let along = rel.dot(*axis);
+            along.abs() < length / 2.0 - eps && (rel - *axis * along).length() < radius - eps
+        }),
+        Emitter::Led {
+            center,
+            normal,
+            u,
+            width,
+            height,
+            ..
+        }
+        | Emitter::MeasuredLed {
+            center,
+            normal,
+            u,
+            width,
+            height,
+            ..
+        } => {
+            let s = c.map(|x| normal.dot(x - *center));
+            if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
+                return false;
+            }
+            // Where the triangle's edges cross the emitter's plane.
+            let v = normal.cross(*u);
+            (0..3).any(|i| {
+                let (a, b) = (i, (i + 1) % 3);
+                if (s[a] > 0.0) == (s[b] > 0.0) {
+                    return false;
+                }
+                let x = c[a] + (c[b] - c[a]) * (s[a] / (s[a] - s[b]));
+                let rel = x - *center;
+                rel.dot(*u).abs() < width / 2.0 && rel.dot(v).abs() < height / 2.0
+            })
+        }
+    }
+}

@@ -1,0 +1,393 @@
+//! CAD geometry as CAD tools write it: one part written as Z-up OBJ in millimetres, Y-up
+//! glTF in metres, STL (ASCII and binary) and PLY (ASCII and binary) loads to the same
+//! triangles and traces to the same tallies; bad files and placements give errors that
+//! name the file and the field.
+
+mod support;
+
+use blutrace::scene::Scene;
+use std::fmt::Write;
+use support::*;
+
+/// The part: a box guide 125 x 62.5 x 3.90625 mm (numbers exact in f32, in millimetres
+/// and in metres), as 12 triangles wound outward, in millimetres, z up.
+fn part() -> Vec<[[f64; 3]; 3]> {
+    let (x, y, z) = (125.0, 62.5, 3.906_25);
+    let c = |i: usize| {
+        [
+            if i & 1 == 0 { 0.0 } else { x },
+            if i & 2 == 0 { 0.0 } else { y },
+            if i & 4 == 0 { 0.0 } else { z },
+        ]
+    };
+    let quads = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+        .collect()
+}
+
+/// glTF's frame: metres, y up (blutrace (x, y, z) is glTF (x, z, -y)).
+fn to_gltf(p: [f64; 3]) -> [f32; 3] {
+    [p[0] / 1000.0, p[2] / 1000.0, -p[1] / 1000.0].map(|v| v as f32)
+}
+
+fn obj(tris: &[[[f64; 3]; 3]]) -> String {
+    let mut s = String::from("usemtl lgp\n");
+    for (k, t) in tris.iter().enumerate() {
+        for p in t {
+            writeln!(s, "v {} {} {}", p[0], p[1], p[2]).unwrap();
+        }
+        writeln!(s, "f {} {} {}", 3 * k + 1, 3 * k + 2, 3 * k + 3).unwrap();
+    }
+    s
+}
+
+fn stl_ascii(tris: &[[[f64; 3]; 3]]) -> String {
+    let mut s = String::from("solid part\n");
+    for t in tris {
+        s += "facet normal 0 0 0\nouter loop\n";
+        for p in t {
+            writeln!(s, "vertex {} {} {}", p[0], p[1], p[2]).unwrap();
+        }
+        s += "endloop\nendfacet\n";
+    }
+    s + "endsolid part\n"
+}
+
+fn stl_binary(tris: &[[[f64; 3]; 3]]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend([0u8; 12]);
+        for p in t {
+            p.iter().for_each(|v| b.extend((*v as f32).to_le_bytes()));
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
+fn ply_header(format: &str, tris: usize) -> String {
+    format!(
+        "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nelement face {tris}\nproperty list uchar int vertex_indices\nend_header\n",
+        3 * tris
+    )
+}
+
+fn ply_ascii(tris: &[[[f64; 3]; 3]]) -> String {
+    let mut s = ply_header("ascii", tris.len());
+    for p in tris.iter().flatten() {
+        writeln!(s, "{} {} {}", p[0], p[1], p[2]).unwrap();
+    }
+    for k in 0..tris.len() {
+        writeln!(s, "3 {} {} {}", 3 * k, 3 * k + 1, 3 * k + 2).unwrap();
+    }
+    s
+}
+
+fn ply_binary(tris: &[[[f64; 3]; 3]]) -> Vec<u8> {
+    let mut b = ply_header("binary_little_endian", tris.len()).into_bytes();
+    for p in tris.iter().flatten() {
+        p.iter().for_each(|v| b.extend((*v as f32).to_le_bytes()));
+    }
+    for k in 0..tris.len() as i32 {
+        b.push(3);
+        [3 * k, 3 * k + 1, 3 * k + 2]
+            .iter()
+            .for_each(|i| b.extend(i.to_le_bytes()));
+    }
+    b
+}
+
+/// A glTF file with one mesh, one primitive, material "lgp", and its .bin buffer.
+fn gltf(tris: &[[[f64; 3]; 3]]) -> (String, Vec<u8>) {
+    let pts: Vec<[f32; 3]> = tris.iter().flatten().map(|p| to_gltf(*p)).collect();
+    let bin: Vec<u8> = pts.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let (lo, hi) = pts
+        .iter()
+        .fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
+            (
+                std::array::from_fn(|i| lo[i].min(p[i])),
+                std::array::from_fn(|i| hi[i].max(p[i])),
+            )
+        });
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],"materials":[{{"name":"lgp"}}],
+"buffers":[{{"uri":"part.bin","byteLength":{}}}],"bufferViews":[{{"buffer":0,"byteLength":{}}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3","min":{lo:?},"max":{hi:?}}}]}}"#,
+        bin.len(),
+        bin.len(),
+        pts.len()
+    );
+    (json, bin)
+}
+
+/// A scene around one geometry file (`geometry` is its `[[geometry]]` body).
+fn scene_toml(geometry: &str) -> String {
+    format!(
+        "version = 1\n[[geometry]]\n{geometry}\n[media.pmma]\nn = 1.49\n\
+         [surfaces.lgp]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [[sources]]\ntype = \"led\"\ncenter = [-0.01, 31.25, 1.953125]\nnormal = [1.0, 0.0, 0.0]\n\
+         u = [0.0, 1.0, 0.0]\nwidth_mm = 60.0\nheight_mm = 3.0\npower_w = 1.0\n\
+         [detector]\norigin = [0.0, 0.0, 4.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [125.0, 62.5]\nbins = [10, 5]\n"
+    )
+}
+
+/// Load a scene whose geometry is one file with these bytes.
+fn load_one(name: &str, file: &str, bytes: &[u8], extra: &str) -> Scene {
+    let geometry = format!("file = \"{file}\"\n{extra}");
+    let path = write_scene(name, &scene_toml(&geometry), &[]);
+    std::fs::write(path.parent().unwrap().join(file), bytes).unwrap();
+    load(&path)
+}
+
+/// The scene's triangles in file coordinates (the loader recentres the scene).
+fn triangles(s: &Scene) -> Vec<[[f64; 3]; 3]> {
+    (0..s.mesh.len() as u32)
+        .map(|p| s.mesh.corners(p).map(|c| (c + s.offset).to_array()))
+        .collect()
+}
+
+/// Equal to rounding: the recentring offset is subtracted and added back.
+fn assert_close(got: &[[[f64; 3]; 3]], want: &[[[f64; 3]; 3]], what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: triangle count");
+    for (g, w) in got.iter().flatten().zip(want.iter().flatten()) {
+        for (a, b) in g.iter().zip(w) {
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "{what}: {g:?} vs {w:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_format_gives_the_same_triangles_and_tallies() {
+    let tris = part();
+    let (json, bin) = gltf(&tris);
+    let gltf_path = write_scene("cad-gltf", &scene_toml("file = \"part.gltf\""), &[]);
+    let dir = gltf_path.parent().unwrap();
+    std::fs::write(dir.join("part.gltf"), json).unwrap();
+    std::fs::write(dir.join("part.bin"), bin).unwrap();
+    let tag = "tag = \"lgp\"";
+    let scenes = [
+        (
+            "obj",
+            load_one("cad-obj", "part.obj", obj(&tris).as_bytes(), ""),
+        ),
+        ("gltf", load(&gltf_path)),
+        (
+            "stl",
+            load_one("cad-stl", "part.stl", stl_ascii(&tris).as_bytes(), tag),
+        ),
+        (
+            "binary stl",
+            load_one("cad-stlb", "part.stl", &stl_binary(&tris), tag),
+        ),
+        (
+            "ply",
+            load_one("cad-ply", "part.ply", ply_ascii(&tris).as_bytes(), tag),
+        ),
+        (
+            "binary ply",
+            load_one("cad-plyb", "part.ply", &ply_binary(&tris), tag),
+        ),
+    ];
+    let reference = trace(&scenes[0].1, 50_000, 3, 2).tally.clone();
+    assert_close(&triangles(&scenes[0].1), &tris, "obj");
+    for (name, s) in &scenes {
+        assert_eq!(
+            triangles(s),
+            triangles(&scenes[0].1),
+            "{name}: triangles differ"
+        );
+        assert!(s.warnings.is_empty(), "{name}: {:?}", s.warnings);
+        assert_eq!(
+            trace(s, 50_000, 3, 2).tally,
+            reference,
+            "{name}: tallies differ"
+        );
+    }
+}
+
+#[test]
+fn units_up_axis_and_rotation_place_the_part() {
+    let tris = part();
+    // The part in metres, y up, turned by -90 degrees about z in the file's frame: the
+    // placement undoes each step.
+    let metres_y_up: Vec<[[f64; 3]; 3]> = tris
+        .iter()
+        .map(|t| t.map(|p| to_gltf(p).map(f64::from)))
+        .collect();
+    let s = load_one(
+        "cad-units",
+        "part.obj",
+        obj(&metres_y_up).as_bytes(),
+        "units = \"m\"\nup = \"y\"",
+    );
+    assert_close(&triangles(&s), &tris, "metres, y up");
+    // A quarter turn about z, then back with a matrix: exact, not to 1e-17.
+    let turned: Vec<[[f64; 3]; 3]> = tris
+        .iter()
+        .map(|t| t.map(|p| [-p[1], p[0], p[2]]))
+        .collect();
+    let s = load_one(
+        "cad-turn",
+        "part.obj",
+        obj(&turned).as_bytes(),
+        "rotate_deg = [0.0, 0.0, -90.0]",
+    );
+    let reference = load_one("cad-plain", "part.obj", obj(&tris).as_bytes(), "");
+    assert_eq!(triangles(&s), triangles(&reference));
+    let s = load_one(
+        "cad-matrix",
+        "part.obj",
+        obj(&turned).as_bytes(),
+        "matrix = [[0.0, 1.0, 0.0, 0.0], [-1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]",
+    );
+    assert_eq!(triangles(&s), triangles(&reference));
+}
+
+#[test]
+fn a_mirroring_matrix_keeps_the_solid_outward() {
+    let tris = part();
+    // The mirror image of the part, wound outward as a CAD tool writes it.
+    let mirrored: Vec<[[f64; 3]; 3]> = tris
+        .iter()
+        .map(|t| [t[0], t[2], t[1]].map(|p| [-p[0], p[1], p[2]]))
+        .collect();
+    let s = load_one(
+        "cad-mirror",
+        "part.obj",
+        obj(&mirrored).as_bytes(),
+        "matrix = [[-1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]",
+    );
+    // No re-winding warning: the loader kept the faces outward.
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // Mirrored back, with windings reversed back: the original triangles.
+    assert_close(&triangles(&s), &tris, "mirrored");
+}
+
+fn load_err(name: &str, file: &str, bytes: &[u8], extra: &str) -> String {
+    let geometry = format!("file = \"{file}\"\n{extra}");
+    let path = write_scene(name, &scene_toml(&geometry), &[]);
+    std::fs::write(path.parent().unwrap().join(file), bytes).unwrap();
+    match Scene::load(&path) {
+        Ok(_) => panic!("{name}: loaded"),
+        Err(e) => format!("{e:#}"),
+    }
+}
+
+/// A bad input: name, file, its bytes, extra geometry keys, what the error must say.
+type BadCase<'a> = (&'a str, &'a str, Vec<u8>, &'a str, &'a [&'a str]);
+
+#[test]
+fn bad_cad_input_names_the_file_and_field() {
+    let tris = part();
+    let text = obj(&tris);
+    let cases: [BadCase; 8] = [
+        (
+            "unit",
+            "part.obj",
+            text.clone().into(),
+            "units = \"furlong\"",
+            &["unknown variant `furlong`"],
+        ),
+        (
+            "up",
+            "part.obj",
+            text.clone().into(),
+            "up = \"x\"",
+            &["unknown variant `x`"],
+        ),
+        (
+            "nan",
+            "part.obj",
+            text.clone().into(),
+            "rotate_deg = [0.0, nan, 0.0]",
+            &["geometry[0].rotate_deg[1]", "finite"],
+        ),
+        (
+            "both",
+            "part.obj",
+            text.clone().into(),
+            "rotate_deg = [0.0, 0.0, 0.0]\nmatrix = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]",
+            &["geometry[0].matrix", "not both"],
+        ),
+        (
+            "notag",
+            "part.stl",
+            stl_binary(&tris),
+            "",
+            &["geometry[0].tag", "part.stl"],
+        ),
+        (
+            "empty",
+            "part.stl",
+            stl_binary(&[]),
+            "tag = \"lgp\"",
+            &["part.stl", "no triangles"],
+        ),
+        (
+            "truncated",
+            "part.stl",
+            stl_binary(&tris)[..300].to_vec(),
+            "tag = \"lgp\"",
+            &["part.stl", "not a valid STL"],
+        ),
+        (
+            "plyjunk",
+            "part.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n".to_vec(),
+            "tag = \"lgp\"",
+            &["part.ply", "not a valid PLY"],
+        ),
+    ];
+    for (name, file, bytes, extra, wants) in cases {
+        let e = load_err(&format!("cad-bad-{name}"), file, &bytes, extra);
+        for w in wants {
+            assert!(e.contains(w), "{name}: {e}");
+        }
+        assert!(e.contains("scene.toml") || e.contains(file), "{name}: {e}");
+    }
+}
+
+#[test]
+fn tag_overrides_the_file_materials_with_a_warning() {
+    let s = load_one(
+        "cad-override",
+        "part.obj",
+        obj(&part()).as_bytes(),
+        "tag = \"lgp\"",
+    );
+    assert!(
+        s.warnings.is_empty(),
+        "same name, nothing replaced: {:?}",
+        s.warnings
+    );
+    let other = obj(&part()).replace("usemtl lgp", "usemtl acrylic");
+    let s = load_one(
+        "cad-override2",
+        "part.obj",
+        other.as_bytes(),
+        "tag = \"lgp\"",
+    );
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("replaces") && w.contains("acrylic")),
+        "{:?}",
+        s.warnings
+    );
+}

@@ -209,15 +209,6 @@ impl Mesh {
         b
     }
 
-    /// Append another mesh, offsetting its indices.
-    pub fn append(&mut self, other: &Mesh) {
-        let base = self.positions.len() as u32;
-        self.positions.extend_from_slice(&other.positions);
-        self.triangles
-            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
-        self.tri_tag.extend_from_slice(&other.tri_tag);
-    }
-
     /// True when `p`, a point on the plane of triangle `prim`, lies inside it (edges
     /// included).
     pub fn contains(&self, prim: u32, p: DVec3) -> bool {

@@ -7,7 +7,7 @@
 
 pub mod accel;
 pub mod bench;
-pub mod cli_enums;
+pub mod cli;
 pub mod detector;
 pub mod estimator;
 pub mod geometry;

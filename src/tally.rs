@@ -27,7 +27,7 @@ pub enum Sign {
 
 impl Sign {
     /// `a += b` or `a -= b`.
-    pub fn apply_i128(self, a: &mut i128, b: i128) {
+    fn apply_i128(self, a: &mut i128, b: i128) {
         match self {
             Sign::Add => *a += b,
             Sign::Remove => *a -= b,
@@ -35,7 +35,7 @@ impl Sign {
     }
 
     /// `a += b` or `a -= b` for counts.
-    pub fn apply_u64(self, a: &mut u64, b: u64) {
+    fn apply_u64(self, a: &mut u64, b: u64) {
         match self {
             Sign::Add => *a += b,
             Sign::Remove => *a -= b,

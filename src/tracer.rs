@@ -19,7 +19,7 @@ use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, MediumId, Outcome};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
-use crate::tally::{ChunkTally, Detection, Fate, Ledger, Tally};
+use crate::tally::{ChunkTally, Detection, Fate, Ledger};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -56,7 +56,7 @@ struct Photon {
 
 impl Tracer<'_> {
     /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
-    pub fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
+    fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
         let (ray, medium) = self.scene.sources.sample(&mut rng);
         let mut p = Photon {
@@ -175,7 +175,7 @@ impl Tracer<'_> {
     }
 
     /// Trace chunk `index` (photons `index*CHUNK .. min(+CHUNK, end)`).
-    pub fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
+    fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
         let lo = index * CHUNK;
         let hi = (lo + CHUNK).min(end);
         let mut out = ChunkTally {
@@ -214,19 +214,6 @@ impl Tracer<'_> {
                 .collect();
             done.iter().for_each(&mut *sink);
         }
-    }
-
-    /// Trace photons `start..end` into one tally.
-    pub fn run_tally(
-        &self,
-        seed: u64,
-        start: u64,
-        end: u64,
-        progress: &(dyn Fn(u64) + Sync),
-    ) -> Tally {
-        let mut tally = Tally::new(self.scene);
-        self.run_range(seed, start, end, progress, &mut |c| tally.absorb(c));
-        tally
     }
 }
 

@@ -178,7 +178,7 @@ mod ffi {
     pub type ReleaseScene = unsafe extern "C" fn(RTCScene);
 
     /// `enum RTCError` names.
-    pub fn error_name(code: c_uint) -> &'static str {
+    pub(super) fn error_name(code: c_uint) -> &'static str {
         match code {
             0 => "RTC_ERROR_NONE",
             1 => "RTC_ERROR_UNKNOWN",

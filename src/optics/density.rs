@@ -133,7 +133,7 @@ impl DensityGrid {
     }
 
     /// The mean over the rows at `x` (the density averaged across the axis).
-    pub fn row_mean(&self, x: f64) -> f64 {
+    fn row_mean(&self, x: f64) -> f64 {
         let (_, ny) = self.shape();
         if ny == 0 {
             return 0.0;
@@ -333,8 +333,9 @@ impl Gradation {
             .find(|&(_, g)| outside(g))
     }
 
+    #[cfg(test)]
     /// Largest value over the span (sampled as [`Gradation::first_outside`] does).
-    pub fn max_over_span(&self) -> f64 {
+    fn max_over_span(&self) -> f64 {
         let samples = if self.is_constant() { 0 } else { 4096 };
         (0..=samples)
             .map(|i| self.at(self.length * i as f64 / samples.max(1) as f64))

@@ -286,11 +286,6 @@ impl DotPattern {
         )
     }
 
-    /// Radius (mm) of the dot centred at face coordinate `u` along the axis.
-    pub fn dot_radius_at(&self, u: f64) -> f64 {
-        self.lattice.dot_radius(self.pitch, self.density_at(u))
-    }
-
     /// The density at face coordinates `c` (mm along `axis`, mm along `across`): a grid
     /// uses both, the other densities only the first.
     pub fn density_at_point(&self, c: DVec2) -> f64 {

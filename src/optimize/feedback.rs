@@ -77,7 +77,7 @@ pub fn knot_count(pattern: &DotPattern, strips: usize) -> usize {
 /// Mean measured flux per knot interval (NaN where no strip falls). Strips in the
 /// objective's margins count here too: their density is still steered towards the
 /// target, it just does not enter the objective.
-pub fn measured_per_knot(pattern: &DotPattern, knots: &[f64], profile: &Profile) -> Vec<f64> {
+fn measured_per_knot(pattern: &DotPattern, knots: &[f64], profile: &Profile) -> Vec<f64> {
     let n = knots.len();
     let x_max = pattern.x_max();
     let mut sum = vec![0.0; n];
@@ -214,7 +214,7 @@ pub fn measured_per_cell(
 /// until every cell has a value: a grid finer than the map leaves knots that no bin is
 /// nearest to, and a knot left alone while its neighbours move would print a stripe.
 /// A grid with no measured cell at all is left as it is.
-pub fn fill_empty_cells(values: &mut [Vec<f64>]) {
+fn fill_empty_cells(values: &mut [Vec<f64>]) {
     loop {
         let old = values.to_vec();
         let (mut filled, mut empty) = (false, false);

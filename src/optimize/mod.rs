@@ -43,7 +43,6 @@
 //! (`write`, with `scene_edit` for `optimized.toml` and `charts` for the PNG charts).
 
 mod charts;
-pub mod cli;
 pub mod export;
 pub mod feedback;
 mod feedback_search;

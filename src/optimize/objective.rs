@@ -36,7 +36,7 @@ pub struct Profile {
 
 /// For every bin of a `nx` x `ny` map of `scene`'s detector: the strip (of `strips` over
 /// `[0, length]` along `pattern`'s axis) holding the bin's centre, if any.
-pub fn strip_of_bins(
+fn strip_of_bins(
     scene: &Scene,
     pattern: &DotPattern,
     nx: usize,

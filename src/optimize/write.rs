@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 impl OptimizeResult {
     /// `history.csv`: one row per iteration.
-    pub fn history_csv(&self) -> String {
+    fn history_csv(&self) -> String {
         let mut s = String::from(
             "iteration,evaluations,photons,seconds,objective,objective_noise,noise_floor,area_cv,map_cv,thirteen_point,step",
         );

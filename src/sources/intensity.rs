@@ -145,7 +145,7 @@ impl IntensityProfile {
     }
 
     /// Parse IES LM-63 text (type C photometry); `path` names the file in errors.
-    pub fn parse_ies(text: &str, path: &Path) -> Result<Self> {
+    fn parse_ies(text: &str, path: &Path) -> Result<Self> {
         let file = path.display();
         let lines: Vec<&str> = text.lines().collect();
         let Some(tilt_at) = lines

@@ -92,17 +92,17 @@ impl GroovePattern {
     }
 
     /// Depth (or height) of a groove filling the fraction `fill` of its pitch (mm).
-    pub fn depth_for(&self, fill: f64) -> f64 {
+    fn depth_for(&self, fill: f64) -> f64 {
         fill.clamp(0.0, 1.0) * self.pitch / (1.0 / self.base_lo.tan() + 1.0 / self.base_hi.tan())
     }
 
     /// Index of the cell holding `s` (mm along `axis` from `origin`).
-    pub fn cell_index(&self, s: f64) -> i64 {
+    fn cell_index(&self, s: f64) -> i64 {
         (s / self.pitch).floor() as i64
     }
 
     /// Fill fraction of cell `k` (the polynomial at its centre, clamped to `[0, 1]`).
-    pub fn cell_fill(&self, k: i64) -> f64 {
+    fn cell_fill(&self, k: i64) -> f64 {
         self.fill.at((k as f64 + 0.5) * self.pitch).clamp(0.0, 1.0)
     }
 
@@ -142,8 +142,9 @@ impl GroovePattern {
         }
     }
 
+    #[cfg(test)]
     /// Height `z` of the profile at `s` (negative in cut notches), for tests and plots.
-    pub fn profile_height(&self, s: f64) -> f64 {
+    fn profile_height(&self, s: f64) -> f64 {
         let c = self.cell(self.cell_index(s));
         for w in c.v.windows(2) {
             let ((s0, z0), (s1, z1)) = (w[0], w[1]);

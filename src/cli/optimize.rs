@@ -9,10 +9,11 @@
 //! ratio of the best design, photons and time so far), then the verification of the
 //! first and final design with error bars, and the files written.
 
-use super::{OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
+use super::scene_path;
+use crate::optimize::{OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
 use crate::scene::Scene;
 use anyhow::Result;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `blutrace optimize`.
 #[derive(Debug, clap::Args)]
@@ -31,15 +32,6 @@ pub struct OptimizeArgs {
     /// No per-iteration lines.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// Accept a scene folder as well as the file itself.
-fn scene_path(p: &Path) -> PathBuf {
-    if p.is_dir() {
-        p.join("scene.toml")
-    } else {
-        p.to_path_buf()
-    }
 }
 
 impl OptimizeArgs {

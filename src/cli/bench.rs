@@ -1,0 +1,65 @@
+//! `blutrace bench`: photons/s per backend as Markdown tables (ratios measured in one run).
+
+use anyhow::Result;
+use std::path::Path;
+
+pub(super) fn bench(
+    scene: &Path,
+    photons: u64,
+    threads: Option<usize>,
+    repeat: usize,
+) -> Result<()> {
+    println!(
+        "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
+    );
+    println!("|---|---:|---|---|---:|---:|---:|");
+    for r in crate::bench::trace_table(scene, photons, threads, repeat)? {
+        println!(
+            "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
+            r.scene,
+            r.triangles,
+            r.backend,
+            if r.convex { "on" } else { "off" },
+            r.photons_per_s,
+            r.interactions_per_s,
+            r.ratio_to_obvhs
+        );
+    }
+    println!();
+    let table = crate::bench::in_guide_table(scene, 1_000_000, repeat)?;
+    let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
+    println!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
+    println!("|---|---:|---:|");
+    for (name, q) in &table {
+        println!("| {name} | {q:.0} | {:.2} |", convex / q);
+    }
+    println!();
+    let large = crate::bench::large_mesh_table(scene, 1_000_000, repeat)?;
+    let obvhs = large.first().map_or(f64::NAN, |(_, _, q)| *q);
+    println!(
+        "| lamp-cavity nearest-hit queries, 540k-triangle mesh (1 thread) | triangles | queries/s | ratio to obvhs |"
+    );
+    println!("|---|---:|---:|---:|");
+    for (name, n, q) in &large {
+        println!("| {name} | {n} | {q:.0} | {:.2} |", q / obvhs);
+    }
+    println!();
+    let rows = crate::bench::error_table(scene, 4.0, threads)?;
+    println!(
+        "| backend | estimator | photons in ~4 s | mean-flux error | per-bin error | FOM mean | FOM bins |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|");
+    for r in rows {
+        println!(
+            "| {} | {:?} | {} | {:.2e} | {:.3} | {:.3e} | {:.3e} |",
+            r.backend,
+            r.estimator,
+            r.photons,
+            r.mean_rel_error,
+            r.bin_rel_error,
+            r.fom_mean,
+            r.fom_bins
+        );
+    }
+    Ok(())
+}

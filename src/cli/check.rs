@@ -1,0 +1,97 @@
+//! `blutrace check`: validate a scene and print what it uses, per geometry file and tag
+//! with sizes in mm (or `--json` for scripts).
+
+use crate::accel::BackendChoice;
+use crate::scene::Scene;
+use crate::scene::geometry_report::BoxMm;
+use anyhow::Result;
+use std::path::Path;
+
+/// "  x from .. to .. mm" for a check line.
+fn bounds(b: Option<BoxMm>) -> String {
+    let Some(b) = b else {
+        return String::new();
+    };
+    let size: Vec<String> = (0..3)
+        .map(|i| format!("{:.3}", b.max[i] - b.min[i]))
+        .collect();
+    format!(
+        ", {} mm, from {:.3?} to {:.3?}",
+        size.join(" x "),
+        b.min,
+        b.max
+    )
+}
+
+pub(super) fn check(path: &Path, json: bool) -> Result<()> {
+    let scene = Scene::load(path)?;
+    if json {
+        let report = serde_json::json!({
+            "scene": scene.name,
+            "scene_file": path.display().to_string(),
+            "geometry": scene.geometry,
+            "warnings": scene.warnings,
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    println!("scene      {} ({})", scene.name, path.display());
+    println!(
+        "geometry   {} triangles, {} tags",
+        scene.mesh.len(),
+        scene.tags.len()
+    );
+    for g in &scene.geometry {
+        println!(
+            "  file {:<25} {:>8} triangles{}",
+            g.file,
+            g.triangles,
+            bounds(g.bounds_mm)
+        );
+        for (tag, t) in &g.tags {
+            println!(
+                "    tag {tag:<22} {:>8} triangles{}",
+                t.triangles,
+                bounds(Some(t.bounds_mm))
+            );
+        }
+    }
+    for ((tag, model), n) in scene
+        .tags
+        .iter()
+        .zip(&scene.surfaces)
+        .zip(scene.triangles_per_tag())
+    {
+        println!("  tag {tag:<20} {:<11} {n} triangles", model.kind());
+    }
+    for (i, m) in scene.media.iter().enumerate() {
+        let path = match scene.convex_solid(i as u16) {
+            Some(s) => format!("convex fast path ({} planes)", s.plane_count()),
+            None if i == 0 => "ambient".to_string(),
+            None => "backend (not a lone convex solid)".to_string(),
+        };
+        println!(
+            "medium     {:<20} n = {}, absorption {} /mm; {path}",
+            m.name, m.n, m.absorption_per_mm
+        );
+    }
+    let backend = crate::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
+    println!("backend    auto picks {}", backend.name());
+    for s in &scene.sources.list {
+        println!("source     {:<20} {:.3} W", s.name, s.power_w);
+    }
+    let d = &scene.detector;
+    println!(
+        "detector   {} x {} mm, {} x {} bins, {} x {} angular bins",
+        d.size[0], d.size[1], d.bins[0], d.bins[1], d.angular_bins[0], d.angular_bins[1]
+    );
+    println!(
+        "trace      {} photons, seed {}, bounce cap {}",
+        scene.default_photons, scene.default_seed, scene.max_bounces
+    );
+    for w in &scene.warnings {
+        println!("warning    {w}");
+    }
+    println!("ok");
+    Ok(())
+}

@@ -1,0 +1,93 @@
+//! The `blutrace` command line: one subcommand per file (`trace` and `merge`, `check`,
+//! `bench`, `optimize`), each a thin layer that parses options, calls the library and
+//! prints. `src/main.rs` only calls [`main`].
+
+mod bench;
+mod check;
+mod enums;
+pub mod optimize;
+mod trace;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Monte Carlo photon tracer for LCD backlight units.
+#[derive(Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Trace photons through a scene and write flux/angular maps and a summary.
+    Trace(trace::TraceArgs),
+    /// Merge shard runs (`trace --shard K/M`) into the outputs of one run.
+    Merge(trace::MergeArgs),
+    /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback).
+    Optimize(optimize::OptimizeArgs),
+    /// Measure photons/s per backend (ratios in one run; see the README's table).
+    Bench {
+        /// Photons per configuration.
+        #[arg(long, default_value_t = 200_000)]
+        photons: u64,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// The notebook scene folder.
+        #[arg(long, default_value = "scenes/notebook14")]
+        scene: PathBuf,
+        /// Rounds per timing (each round measures every configuration once; medians).
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
+    },
+    /// Validate a scene and print what it uses.
+    Check {
+        /// Scene file (or a folder holding scene.toml).
+        scene: PathBuf,
+        /// Write the geometry report (files and tags with triangle counts and bounding
+        /// boxes in mm, after all transforms) and the warnings as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Parse the command line, run it, and report an error on stderr.
+pub fn main() -> ExitCode {
+    match Cli::parse().command.execute() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+impl Command {
+    fn execute(self) -> Result<()> {
+        match self {
+            Command::Trace(args) => trace::trace(args),
+            Command::Merge(args) => trace::merge(args),
+            Command::Optimize(args) => optimize::run(args),
+            Command::Bench {
+                photons,
+                threads,
+                scene,
+                repeat,
+            } => bench::bench(&scene, photons, threads, repeat),
+            Command::Check { scene, json } => check::check(&scene_path(&scene), json),
+        }
+    }
+}
+
+/// Accept a scene folder as well as the file itself.
+pub(crate) fn scene_path(p: &Path) -> PathBuf {
+    if p.is_dir() {
+        p.join("scene.toml")
+    } else {
+        p.to_path_buf()
+    }
+}

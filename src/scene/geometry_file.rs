@@ -127,7 +127,7 @@ impl Format {
     }
 
     /// The units its specification prescribes, else millimetres.
-    pub fn default_units(self) -> Units {
+    fn default_units(self) -> Units {
         match self {
             Format::Gltf => Units::M,
             _ => Units::Mm,
@@ -135,7 +135,7 @@ impl Format {
     }
 
     /// The up axis its specification prescribes, else z.
-    pub fn default_up(self) -> UpAxis {
+    fn default_up(self) -> UpAxis {
         match self {
             Format::Gltf => UpAxis::Y,
             _ => UpAxis::Z,
@@ -227,7 +227,8 @@ impl GeometrySpec {
             return Err(ctx.err(&format!("geometry[{i}].tag"), "must not be empty"));
         }
         let placement = self.placement(ctx, i, format, warnings)?;
-        let mut tris = meshio::load(path, format, placement.transform, self.tag.as_deref())?;
+        let mut tris = meshio::load(path, format, placement.transform, self.tag.as_deref())
+            .map_err(|e| ctx.err(&format!("geometry[{i}].file"), format!("{e:#}")))?;
         if placement.mirrors {
             tris.triangles.iter_mut().for_each(|t| t.swap(1, 2));
         }

@@ -126,15 +126,13 @@ pub fn detector_cuts(
     let mut hit = BTreeMap::new();
     for (p, &tag) in mesh.tri_tag.iter().enumerate() {
         let c = mesh.corners(p as u32);
-        let s = c.map(|x| n.dot(x - d.origin));
-        if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
-            continue;
-        }
-        let inside = c.iter().any(|x| {
-            let (a, b) = ((*x - d.origin).dot(d.u), (*x - d.origin).dot(d.v));
-            (0.0..=d.size[0]).contains(&a) && (0.0..=d.size[1]).contains(&b)
-        });
-        if inside {
+        let plane = Plane {
+            origin: d.origin,
+            u: d.u,
+            v: d.v,
+            n,
+        };
+        if plane.cut_meets(c, [0.0, 0.0], d.size, eps) {
             hit.entry(tag).or_insert(c[0] + offset);
         }
     }
@@ -205,21 +203,86 @@ fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
             height,
             ..
         } => {
-            let s = c.map(|x| normal.dot(x - *center));
-            if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
-                return false;
-            }
-            // Where the triangle's edges cross the emitter's plane.
-            let v = normal.cross(*u);
-            (0..3).any(|i| {
+            let plane = Plane {
+                origin: *center,
+                u: *u,
+                v: normal.cross(*u),
+                n: *normal,
+            };
+            let half = [width / 2.0, height / 2.0];
+            plane.cut_meets(c, half.map(|h| -h), half, eps)
+        }
+    }
+}
+
+/// A plane with an in-plane frame: points `origin + a u + b v`, normal `n`.
+struct Plane {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+    n: DVec3,
+}
+
+impl Plane {
+    /// True when triangle `c` passes through the plane (vertices more than `eps` on both
+    /// sides) along a segment that meets the rectangle `lo..hi` of frame coordinates.
+    fn cut_meets(&self, c: [DVec3; 3], lo: [f64; 2], hi: [f64; 2], eps: f64) -> bool {
+        let s = c.map(|x| self.n.dot(x - self.origin));
+        if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
+            return false;
+        }
+        let ends: Vec<[f64; 2]> = (0..3)
+            .filter_map(|i| {
                 let (a, b) = (i, (i + 1) % 3);
-                if (s[a] > 0.0) == (s[b] > 0.0) {
+                ((s[a] > 0.0) != (s[b] > 0.0)).then(|| {
+                    let x = c[a] + (c[b] - c[a]) * (s[a] / (s[a] - s[b])) - self.origin;
+                    [x.dot(self.u), x.dot(self.v)]
+                })
+            })
+            .collect();
+        match ends.as_slice() {
+            [p] => segment_meets_box(*p, *p, lo, hi),
+            [p, q, ..] => segment_meets_box(*p, *q, lo, hi),
+            [] => false,
+        }
+    }
+}
+
+/// Liang-Barsky: does the segment `p..q` meet the box `lo..hi`?
+fn segment_meets_box(p: [f64; 2], q: [f64; 2], lo: [f64; 2], hi: [f64; 2]) -> bool {
+    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+    for k in 0..2 {
+        let d = q[k] - p[k];
+        for (num, den) in [(p[k] - lo[k], -d), (hi[k] - p[k], d)] {
+            if den == 0.0 {
+                if num < 0.0 {
                     return false;
                 }
-                let x = c[a] + (c[b] - c[a]) * (s[a] / (s[a] - s[b]));
-                let rel = x - *center;
-                rel.dot(*u).abs() < width / 2.0 && rel.dot(v).abs() < height / 2.0
-            })
+            } else {
+                let t = num / den;
+                if den < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+            }
         }
+    }
+    t0 <= t1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segments_and_boxes() {
+        let (lo, hi) = ([0.0, 0.0], [1.0, 1.0]);
+        assert!(segment_meets_box([-1.0, 0.5], [2.0, 0.5], lo, hi));
+        assert!(segment_meets_box([0.5, 0.5], [0.5, 0.5], lo, hi));
+        assert!(!segment_meets_box([-1.0, 2.0], [2.0, 1.5], lo, hi));
+        assert!(!segment_meets_box([1.5, -1.0], [1.5, 2.0], lo, hi));
+        assert!(segment_meets_box([-0.5, 0.0], [0.5, 2.0], lo, hi));
+        assert!(!segment_meets_box([-1.0, 0.5], [-0.1, 0.9], lo, hi));
     }
 }

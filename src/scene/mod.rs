@@ -20,7 +20,6 @@ use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh, spawn_epsilon};
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
-use crate::rng::PhotonRng;
 use crate::sources::Sources;
 use crate::spec_check::Ctx;
 use anyhow::{Context, Result};
@@ -110,6 +109,11 @@ impl Scene {
             ));
         }
         solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
+        warnings.extend(solids::overlap_warnings(
+            &mesh,
+            |p| surfaces[mesh.tri_tag[p] as usize].interface(),
+            &media,
+        ));
         fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
         let sources = Sources::build(&ctx, &file.sources, &media)?;
         let detector = build_detector(&ctx, &file.detector)?;
@@ -180,16 +184,6 @@ impl Scene {
     /// nudged off the surface to the side `dir` goes. One rule for all backends.
     pub fn spawn_point(&self, point: DVec3, normal: DVec3, dir: DVec3) -> DVec3 {
         crate::geometry::spawn_origin(point, normal, dir, self.spawn_eps)
-    }
-
-    /// A Beer-Lambert free path (mm) in `medium`; infinite in a lossless medium.
-    pub fn free_path(&self, medium: MediumId, rng: &mut PhotonRng) -> f64 {
-        let a = self.media[medium as usize].absorption_per_mm;
-        if a > 0.0 {
-            -(1.0 - rng.uniform()).ln() / a
-        } else {
-            f64::INFINITY
-        }
     }
 
     /// A 64-bit hash of everything that decides the physics, over canonical serialized

@@ -196,3 +196,91 @@ fn signed_volume(mesh: &Mesh, p: usize) -> f64 {
     let [a, b, c] = mesh.corners(p as u32);
     a.dot(b.cross(c)) / 6.0
 }
+
+/// Warnings where two media's closed solids overlap (one's surface passes through the
+/// other's), or where a solid lies wholly inside another medium's solid while its faces
+/// name a different medium outside. Tested with the generalized winding number of up to
+/// [`OVERLAP_SAMPLES`] vertices of each solid against every other solid (robust where a
+/// vertex lies on the other's surface: touching solids do not count).
+pub(super) fn overlap_warnings(
+    mesh: &Mesh,
+    surfaces_by_tri: impl Fn(usize) -> Option<crate::optics::medium::Interface>,
+    media: &[Medium],
+) -> Vec<String> {
+    let solid = |m: usize| -> Vec<usize> {
+        (0..mesh.len())
+            .filter(|&p| surfaces_by_tri(p).is_some_and(|i| i.inside as usize == m))
+            .collect()
+    };
+    let solids: Vec<(usize, Vec<usize>)> = (1..media.len())
+        .map(|m| (m, solid(m)))
+        .filter(|(_, t)| !t.is_empty())
+        .collect();
+    let mut out = Vec::new();
+    for (m, tris) in &solids {
+        let verts = sample_vertices(mesh, tris);
+        for (k, other) in solids.iter().filter(|(k, _)| k != m) {
+            let w: Vec<f64> = verts.iter().map(|&p| winding(mesh, other, p)).collect();
+            let inside = w.iter().any(|&w| w > 0.75);
+            let outside = w.iter().any(|&w| w < 0.25);
+            let (a, b) = (&media[*m].name, &media[*k].name);
+            if inside && outside && m < k {
+                out.push(format!(
+                    "the closed solids of media '{a}' and '{b}' overlap: their surfaces cross"
+                ));
+            } else if inside && !outside {
+                let named = tris
+                    .iter()
+                    .filter_map(|&p| surfaces_by_tri(p))
+                    .any(|i| i.outside as usize != *k);
+                if named {
+                    out.push(format!(
+                        "medium '{a}' lies inside medium '{b}', but faces of '{a}' name \
+                         another medium outside them"
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Vertices tested per solid for overlaps.
+pub const OVERLAP_SAMPLES: usize = 512;
+
+/// Up to [`OVERLAP_SAMPLES`] vertices of the solid `tris`, each moved a hair into the
+/// solid (against the sum of its faces' outward normals), so that a vertex lying on
+/// another solid's surface (solids that touch) is judged by the side it really is on.
+fn sample_vertices(mesh: &Mesh, tris: &[usize]) -> Vec<glam::DVec3> {
+    let mut normal: HashMap<u32, glam::DVec3> = HashMap::new();
+    for &p in tris {
+        let n = mesh.area_normal(p as u32).normalize_or_zero();
+        for v in mesh.triangles[p] {
+            *normal.entry(v).or_default() += n;
+        }
+    }
+    let mut v: Vec<u32> = normal.keys().copied().collect();
+    v.sort_unstable();
+    let hair = 1e-7 * mesh.bounds().diagonal();
+    let step = v.len().div_ceil(OVERLAP_SAMPLES).max(1);
+    v.iter()
+        .step_by(step)
+        .map(|i| mesh.positions[*i as usize] - normal[i].normalize_or_zero() * hair)
+        .collect()
+}
+
+/// Generalized winding number of the closed, outward-wound surface `tris` about `p`:
+/// 1 inside, 0 outside, 1/2 on the surface (van Oosterom and Strackee's solid angle).
+fn winding(mesh: &Mesh, tris: &[usize], p: glam::DVec3) -> f64 {
+    let total: f64 = tris
+        .iter()
+        .map(|&t| {
+            let [a, b, c] = mesh.corners(t as u32).map(|x| x - p);
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let num = a.dot(b.cross(c));
+            let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            2.0 * num.atan2(den)
+        })
+        .sum();
+    total / (4.0 * std::f64::consts::PI)
+}

@@ -120,8 +120,8 @@ impl SourceSpec {
                 emitter: Emitter::Ccfl {
                     center: ctx.point(&f("center"), *center)?,
                     axis: ctx.direction(&f("axis"), *axis)?,
-                    radius: ctx.positive(&f("radius_mm"), *radius_mm)?,
-                    length: ctx.positive(&f("length_mm"), *length_mm)?,
+                    radius: ctx.length(&f("radius_mm"), *radius_mm)?,
+                    length: ctx.length(&f("length_mm"), *length_mm)?,
                 },
                 medium: medium_id(ctx, &f("medium"), medium, media)?,
             },
@@ -145,8 +145,8 @@ impl SourceSpec {
                 }
                 let (center, width, height) = (
                     ctx.point(&f("center"), *center)?,
-                    ctx.positive(&f("width_mm"), *width_mm)?,
-                    ctx.positive(&f("height_mm"), *height_mm)?,
+                    ctx.length(&f("width_mm"), *width_mm)?,
+                    ctx.length(&f("height_mm"), *height_mm)?,
                 );
                 Source {
                     name: name.clone().unwrap_or_else(|| format!("led{i}")),
@@ -319,6 +319,10 @@ fn rectangle_point(
     center + u * ((rng.uniform() - 0.5) * width) + v * ((rng.uniform() - 0.5) * height)
 }
 
+/// Largest total source power (W): a backlight's lamps draw watts; the bound keeps every
+/// ledger sum finite (two sources of 1.7e308 W would overflow it).
+pub const MAX_TOTAL_POWER_W: f64 = 1e9;
+
 /// All sources of a scene with the cumulative power table used to pick one per photon.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sources {
@@ -352,6 +356,13 @@ impl Sources {
             .enumerate()
             .map(|(i, s)| s.build(ctx, i, media))
             .collect::<Result<Vec<_>>>()?;
+        let total: f64 = list.iter().map(|s| s.power_w).sum();
+        if total > MAX_TOTAL_POWER_W {
+            return Err(ctx.err(
+                "sources",
+                format!("total power_w {total:e} W exceeds {MAX_TOTAL_POWER_W:e} W"),
+            ));
+        }
         Ok(Self::new(list))
     }
 

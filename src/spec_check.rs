@@ -5,6 +5,10 @@
 //! (surface models, media, sources) all check their values with a [`Ctx`].
 
 use anyhow::Result;
+
+/// Largest coordinate or length (mm) a scene may use: beyond it f64 resolves no better
+/// than 0.1 mm, a unit or export error either way.
+pub const MAX_COORDINATE: f64 = 1e12;
 use glam::DVec3;
 use std::path::Path;
 
@@ -59,12 +63,30 @@ impl Ctx<'_> {
         x.map(|v| self.positive(field, v)).transpose()
     }
 
-    /// A point with finite coordinates (`field[i]` names a bad one).
+    /// A point with finite coordinates within [`MAX_COORDINATE`] mm (`field[i]` names a
+    /// bad one).
     pub fn point(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
         for (i, c) in p.iter().enumerate() {
-            self.finite(&format!("{field}[{i}]"), *c)?;
+            let f = format!("{field}[{i}]");
+            if self.finite(&f, *c)?.abs() > MAX_COORDINATE {
+                return Err(self.err(
+                    &f,
+                    format!("must be within ±{MAX_COORDINATE:e} mm, got {c}"),
+                ));
+            }
         }
         Ok(DVec3::from_array(p))
+    }
+
+    /// A length (mm): finite, > 0 and at most [`MAX_COORDINATE`].
+    pub fn length(&self, field: &str, x: f64) -> Result<f64> {
+        if self.positive(field, x)? > MAX_COORDINATE {
+            return Err(self.err(
+                field,
+                format!("must be at most {MAX_COORDINATE:e} mm, got {x}"),
+            ));
+        }
+        Ok(x)
     }
 
     /// A non-zero direction, normalized.

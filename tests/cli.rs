@@ -65,3 +65,115 @@ fn a_bad_scene_names_file_and_field_and_writes_nothing() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists(), "no output for a scene that does not load");
 }
+
+/// The files of a complete trace output set.
+const OUTPUTS: [&str; 6] = [
+    "angular.exr",
+    "convergence.csv",
+    "convergence.png",
+    "flux.exr",
+    "flux.png",
+    "summary.json",
+];
+
+fn assert_complete(dir: &std::path::Path, what: &str) {
+    for f in OUTPUTS {
+        assert!(dir.join(f).is_file(), "{what}: {f} missing");
+    }
+}
+
+/// Runs in which no photon, or no photon at all, reaches the target still write every
+/// output: a chart with nothing to draw becomes a placeholder, never an error.
+#[test]
+fn runs_with_nothing_detected_write_the_whole_output_set() {
+    let dir = tmp("empty");
+    let cases: [&[&str]; 4] = [
+        &["scenes/test/slab-edge-lit", "--photons", "20000"],
+        &["scenes/test/slab", "--photons", "0"],
+        &["scenes/test/slab", "--photons", "1"],
+        &["scenes/test/slab", "--max-time", "0"],
+    ];
+    for (k, case) in cases.iter().enumerate() {
+        let out = dir.path().join(format!("run{k}"));
+        let mut args = vec!["trace"];
+        args.extend_from_slice(case);
+        args.extend(["--quiet", "--out", out.to_str().unwrap()]);
+        let run = blutrace(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{case:?}: {err}");
+        assert_complete(&out, &format!("{case:?}"));
+    }
+    let text = String::from_utf8_lossy(
+        &blutrace(&[
+            "trace",
+            "scenes/test/slab-edge-lit",
+            "--photons",
+            "9000",
+            "--quiet",
+            "--out",
+            dir.path().join("note").to_str().unwrap(),
+        ])
+        .stdout,
+    )
+    .to_string();
+    assert!(text.contains("no photon reached the target"), "{text}");
+    // Shards of such a run merge into a complete set too.
+    let shards: Vec<String> = (0..2)
+        .map(|k| {
+            let s = dir.path().join(format!("shard{k}"));
+            let run = blutrace(&[
+                "trace",
+                "scenes/test/slab-edge-lit",
+                "--photons",
+                "100",
+                "--shard",
+                &format!("{k}/2"),
+                "--quiet",
+                "--out",
+                s.to_str().unwrap(),
+            ]);
+            assert!(run.status.success());
+            s.to_str().unwrap().to_string()
+        })
+        .collect();
+    let merged = dir.path().join("merged");
+    let run = blutrace(&[
+        "merge",
+        &shards[0],
+        &shards[1],
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_complete(&merged, "merge");
+}
+
+#[test]
+fn options_that_could_never_finish_are_refused() {
+    let dir = tmp("opts");
+    let out = dir.path().join("o");
+    for (flag, value, says) in [
+        ("--max-time", "NaN", "--max-time"),
+        ("--max-time=-1", "", "--max-time"),
+        ("--threads", "100000", "--threads"),
+        ("--threads", "0", "--threads"),
+        ("--target-error", "inf", "--target-error"),
+    ] {
+        let mut args = vec!["trace", "scenes/test/slab", flag];
+        if !value.is_empty() {
+            args.push(value);
+        }
+        args.extend(["--quiet", "--out", out.to_str().unwrap()]);
+        let run = blutrace(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success() && err.contains(says),
+            "{flag} {value}: {err}"
+        );
+        assert!(!out.exists(), "{flag} {value}: wrote outputs");
+    }
+}

@@ -193,3 +193,51 @@ fn garbage_toml_names_the_file() {
     let msg = error_of("garbage", "version = 1\n[[geometry]\n");
     assert_mentions(&msg, &["scene.toml"]);
 }
+
+#[test]
+fn numbers_are_bounded() {
+    let two_sources = GOOD.replace("power_w = 1.0", "power_w = 1.7e308")
+        + "[[sources]]\ntype = \"ccfl\"\ncenter = [-12.0, 0.0, 0.0]\naxis = [0.0, 1.0, 0.0]\n\
+           radius_mm = 1.0\nlength_mm = 20.0\npower_w = 1.7e308\n";
+    // The extra source lands inside [detector] as written, so put it before that table.
+    let two_sources = two_sources.replacen("[detector]", "[detector_placeholder]", 1);
+    let (head, tail) = two_sources.split_once("[detector_placeholder]").unwrap();
+    let (det, extra) = tail.split_once("[[sources]]").unwrap();
+    let two_sources = format!("{head}[[sources]]{extra}[detector]{det}");
+    let msg = error_of("power", &two_sources);
+    assert_mentions(&msg, &["scene.toml", "sources", "total power_w"]);
+    let msg = error_of(
+        "centre",
+        &GOOD.replace("center = [-12.0, 0.0, 0.0]", "center = [-12.0, 1e300, 0.0]"),
+    );
+    assert_mentions(&msg, &["sources[0].center[1]", "1e12"]);
+    let msg = error_of(
+        "radius",
+        &GOOD.replace("radius_mm = 1.0", "radius_mm = 1e300"),
+    );
+    assert_mentions(&msg, &["sources[0].radius_mm", "at most"]);
+    let msg = error_of(
+        "detsize",
+        &GOOD.replace("size_mm = [20.0, 20.0]", "size_mm = [1e300, 20.0]"),
+    );
+    assert_mentions(&msg, &["detector.size_mm[0]", "at most"]);
+}
+
+#[test]
+fn bins_beyond_the_memory_budget_are_refused_before_tracing() {
+    let obj = plate();
+    let big = GOOD.replace(
+        "size_mm = [20.0, 20.0]",
+        "size_mm = [20.0, 20.0]\nbins = [20000, 20000]",
+    );
+    let scene = load(&write_scene("bins", &big, &[("plate.obj", &obj)]));
+    let e = blutrace::run::check_tally_budget(&scene).unwrap_err();
+    assert!(format!("{e:#}").contains("use fewer bins"), "{e:#}");
+    let opts = blutrace::run::RunOptions {
+        photons: 10,
+        ..Default::default()
+    };
+    assert!(blutrace::run::trace(&scene, &opts, &|_| {}).is_err());
+    let ok = load(&write_scene("bins-ok", GOOD, &[("plate.obj", &obj)]));
+    assert!(blutrace::run::check_tally_budget(&ok).unwrap() < 1 << 30);
+}

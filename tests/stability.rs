@@ -2150,7 +2150,7 @@ fn mesh_non_finite() -> Row {
     Row {
         id: "mesh-non-finite",
         risk: "A vertex at NaN, infinity or 1e300 (a broken export, a unit slip): NaN bounds and normals, f32 overflow in the BVH, a panic.",
-        does: "Loading checks every vertex after scale and translate: finite and within 1e12 mm of the origin (`scene::MAX_COORDINATE`), else an error naming the scene file, the geometry file, the vertex and its coordinates.",
+        does: "Loading checks every vertex after scale and translate: finite and within 1e12 mm of the origin (`spec_check::MAX_COORDINATE`), else an error naming the scene file, the geometry file, the vertex and its coordinates.",
         expected: "an error naming the geometry file and the vertex, for each; no panic".into(),
         measured: shown.join("; "),
         verdict: verdict(ok, || "non-finite geometry is not refused".into()),

@@ -25,11 +25,13 @@ fn bounds(b: Option<BoxMm>) -> String {
 
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     let scene = Scene::load(path)?;
+    let tally_bytes = crate::run::check_tally_budget(&scene)?;
     if json {
         let report = serde_json::json!({
             "scene": scene.name,
             "scene_file": path.display().to_string(),
             "geometry": scene.geometry,
+            "tally_bytes": tally_bytes,
             "warnings": scene.warnings,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -82,8 +84,15 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     }
     let d = &scene.detector;
     println!(
-        "detector   {} x {} mm, {} x {} bins, {} x {} angular bins",
-        d.size[0], d.size[1], d.bins[0], d.bins[1], d.angular_bins[0], d.angular_bins[1]
+        "detector   {} x {} mm, {} x {} bins, {} x {} angular bins; tallies {:.1} MiB (at most {} GiB)",
+        d.size[0],
+        d.size[1],
+        d.bins[0],
+        d.bins[1],
+        d.angular_bins[0],
+        d.angular_bins[1],
+        tally_bytes as f64 / (1u64 << 20) as f64,
+        crate::run::TALLY_BUDGET_BYTES >> 30
     );
     println!(
         "trace      {} photons, seed {}, bounce cap {}",

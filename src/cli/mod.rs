@@ -91,3 +91,47 @@ pub(crate) fn scene_path(p: &Path) -> PathBuf {
         p.to_path_buf()
     }
 }
+
+/// The default output folder for a run named `name`: `out/<name>`, the name made a plain
+/// file name (letters, digits, `.`, `-`, `_`; anything else becomes `_`; no leading dot),
+/// so a scene's `name` can never point outside `out/` or at `out/` itself.
+pub(crate) fn default_out(name: &str) -> PathBuf {
+    let clean: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let clean = clean.trim_start_matches('.');
+    let clean = if clean.is_empty() { "scene" } else { clean };
+    PathBuf::from("out").join(clean)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::default_out;
+    use std::path::PathBuf;
+
+    #[test]
+    fn default_output_folders_stay_inside_out() {
+        for (name, want) in [
+            ("notebook14", "notebook14"),
+            ("../../x", "_.._x"),
+            ("", "scene"),
+            ("..", "scene"),
+            ("a/b c", "a_b_c"),
+            ("/etc", "_etc"),
+            (".hidden", "hidden"),
+        ] {
+            assert_eq!(
+                default_out(name),
+                PathBuf::from("out").join(want),
+                "{name:?}"
+            );
+        }
+    }
+}

@@ -9,7 +9,7 @@
 //! ratio of the best design, photons and time so far), then the verification of the
 //! first and final design with error bars, and the files written.
 
-use super::scene_path;
+use super::{default_out, scene_path};
 use crate::optimize::{OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
 use crate::scene::Scene;
 use anyhow::Result;
@@ -53,7 +53,7 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
     let options = args.options(&scene);
     let out = args.out.clone().unwrap_or_else(|| {
         let suffix = if options.tunes_grid() { "-2d" } else { "" };
-        PathBuf::from("out").join(format!(
+        default_out(&format!(
             "{}-optimize-{}{suffix}",
             scene.name, options.method
         ))

@@ -1,7 +1,7 @@
 //! `blutrace trace` and `blutrace merge`: run a scene (or one shard of it), merge shards,
 //! and print the run's report.
 
-use super::scene_path;
+use super::{default_out, scene_path};
 use crate::accel::BackendChoice;
 use crate::estimator::Estimator;
 use crate::run::{self, RunOptions, Shard, TargetMetric};
@@ -98,9 +98,7 @@ pub(super) fn trace(args: TraceArgs) -> Result<()> {
     let bar = progress_bar(last - first, args.quiet);
     let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
-    let out = args
-        .out
-        .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+    let out = args.out.unwrap_or_else(|| default_out(&scene.name));
     if let Some(sh) = args.shard {
         let (first, last) = options.photon_range();
         let file = shard::write_shard(&result, &out)?;
@@ -171,8 +169,12 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         u.thirteen_point_min_over_max,
         err(e.thirteen_point_min_over_max, 3, false)
     );
-    if !e.cv.is_finite() {
-        let chunk = crate::tracer::CHUNK;
+    let chunk = crate::tracer::CHUNK;
+    if l.detected_w == 0.0 {
+        println!(
+            "note       no photon reached the target: the map and its uniformity metrics are empty"
+        );
+    } else if s.photons < 2 * chunk {
         println!(
             "note       errors of the map's metrics (jackknife over chunks of {chunk} photons) need at least {} photons; this run traced {}",
             2 * chunk,

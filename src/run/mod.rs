@@ -203,6 +203,37 @@ pub struct RunResult<'a> {
     pub history: Vec<ConvergenceRow>,
 }
 
+/// Most memory (bytes) a run's tallies may take: the run's own flux and angular grids and
+/// one copy per jackknife group. Bins beyond it are refused before anything is traced.
+pub const TALLY_BUDGET_BYTES: u64 = 4 << 30;
+
+/// Bytes the tallies of a run of `scene` take (see [`TALLY_BUDGET_BYTES`]).
+pub fn tally_bytes(scene: &Scene) -> u64 {
+    let d = &scene.detector;
+    let bins = (d.bins[0] * d.bins[1] + d.angular_bins[0] * d.angular_bins[1]) as u64;
+    bins * std::mem::size_of::<crate::tally::BinStats>() as u64 * (GROUPS as u64 + 1)
+}
+
+/// [`tally_bytes`], or an error when over the budget.
+pub fn check_tally_budget(scene: &Scene) -> Result<u64> {
+    let bytes = tally_bytes(scene);
+    if bytes > TALLY_BUDGET_BYTES {
+        bail!(
+            "{}: detector.bins and detector.angular_bins need {:.1} GiB of tallies ({} copies \
+             of every bin, for the jackknife groups); at most {} GiB: use fewer bins",
+            scene.path.display(),
+            bytes as f64 / (1u64 << 30) as f64,
+            GROUPS + 1,
+            TALLY_BUDGET_BYTES >> 30
+        );
+    }
+    Ok(bytes)
+}
+
+/// Most worker threads a run accepts: far more than any node has cores (results do not
+/// depend on the count), few enough that starting them cannot exhaust the machine.
+pub const MAX_THREADS: usize = 1024;
+
 /// Trace `scene` as `options` say. `progress` receives photon counts as chunks finish.
 pub fn trace<'a>(
     scene: &'a Scene,
@@ -214,6 +245,17 @@ pub fn trace<'a>(
     {
         bail!("--target-error must be a positive number, got {e}");
     }
+    if let Some(t) = options.max_time_s
+        && !(t >= 0.0 && t.is_finite())
+    {
+        bail!("--max-time must be a finite number of seconds >= 0, got {t}");
+    }
+    if let Some(n) = options.threads
+        && !(1..=MAX_THREADS).contains(&n)
+    {
+        bail!("--threads must be within 1..={MAX_THREADS}, got {n}");
+    }
+    check_tally_budget(scene)?;
     if options.shard.is_some() && (options.target_error.is_some() || options.max_time_s.is_some()) {
         bail!("a shard traces a fixed photon range: --target-error and --max-time do not apply");
     }

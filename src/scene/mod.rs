@@ -21,7 +21,7 @@ use crate::geometry::{Aabb, Mesh, spawn_epsilon};
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
 use crate::sources::Sources;
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, MAX_COORDINATE};
 use anyhow::{Context, Result};
 use config::{DetectorSpec, SceneFile, SurfaceSpec};
 use geometry_report::GeometryReport;
@@ -289,9 +289,6 @@ fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
         .collect()
 }
 
-/// Largest vertex coordinate (mm) a geometry file may have after scale and translate.
-pub const MAX_COORDINATE: f64 = 1e12;
-
 fn default_name(path: &Path) -> String {
     path.parent()
         .and_then(|p| p.file_name())
@@ -481,8 +478,8 @@ fn build_detector(ctx: &Ctx, d: &DetectorSpec) -> Result<TargetPlane> {
         u,
         v,
         size: [
-            ctx.positive("detector.size_mm[0]", d.size_mm[0])?,
-            ctx.positive("detector.size_mm[1]", d.size_mm[1])?,
+            ctx.length("detector.size_mm[0]", d.size_mm[0])?,
+            ctx.length("detector.size_mm[1]", d.size_mm[1])?,
         ],
         bins: d.bins,
         angular_bins: d.angular_bins,

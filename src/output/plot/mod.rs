@@ -87,12 +87,13 @@ pub struct Chart {
 
 /// Write `chart` as an 800×560 pixel PNG file to `path` (overwriting it).
 ///
-/// Fails, without creating the file, if the chart has no series or no drawable point (all
-/// points non-finite or, on a logarithmic axis, not positive), or if a linear axis range
-/// is too wide to represent (beyond `±f64::MAX`).
+/// A chart never costs a run its results: when there is nothing to draw (no series, no
+/// drawable point: all points non-finite or, on a logarithmic axis, not positive; or an
+/// axis range too wide to represent), the file is a framed placeholder with the title and
+/// the reason. Fails only if the file cannot be written.
 pub fn write_chart(path: &Path, chart: &Chart) -> Result<()> {
     let what = || format!("cannot write chart {}", path.display());
-    let r = render(chart).with_context(what)?;
+    let r = render(chart).unwrap_or_else(|why| placeholder(chart, &format!("{why:#}")));
     let labels: Vec<&str> = chart.series.iter().map(|s| s.label.as_str()).collect();
     let comment = format!(
         "line chart {:?}: x = {:?} ({:?}), y = {:?} ({:?}); series: {}",
@@ -254,6 +255,48 @@ fn data_ranges(chart: &Chart) -> Option<((f64, f64), (f64, f64))> {
         }
     }
     r
+}
+
+/// A chart with nothing to draw: its frame, its title and why, wrapped to the width.
+fn placeholder(chart: &Chart, why: &str) -> Rendered {
+    let mut canvas = Canvas::new(WIDTH, HEIGHT, BACKGROUND);
+    let plot = Rect::new(
+        MARGIN,
+        PLOT_TOP,
+        WIDTH - 2 * MARGIN,
+        HEIGHT - PLOT_TOP - MARGIN,
+    );
+    canvas.frame(plot, FRAME);
+    let centred = |canvas: &mut Canvas, y: i64, line: &str| {
+        canvas.text((WIDTH - text_width(line)) / 2, y, line, INK);
+    };
+    centred(&mut canvas, MARGIN / 2, &chart.title);
+    let mut lines = vec![String::from("nothing to draw:")];
+    let max_chars = ((plot.w - 40) / text_width("m").max(1)) as usize;
+    for word in why.split_whitespace() {
+        let last = lines.last_mut().expect("one line at least");
+        if last.len() + 1 + word.len() > max_chars && !last.is_empty() {
+            lines.push(word.to_string());
+        } else {
+            if !last.is_empty() {
+                last.push(' ');
+            }
+            last.push_str(word);
+        }
+    }
+    let top = plot.y + plot.h / 2 - (lines.len() as i64 * (CHAR_H + 6)) / 2;
+    for (k, line) in lines.iter().enumerate() {
+        centred(&mut canvas, top + k as i64 * (CHAR_H + 6), line);
+    }
+    Rendered {
+        width: WIDTH,
+        height: HEIGHT,
+        rgb: canvas.rgb,
+        plot,
+        x: Axis::fit(Scale::Linear, 0.0, 1.0).expect("a unit axis fits"),
+        y: Axis::fit(Scale::Linear, 0.0, 1.0).expect("a unit axis fits"),
+        legend: None,
+    }
 }
 
 /// Draw `chart`.

@@ -177,3 +177,45 @@ fn options_that_could_never_finish_are_refused() {
         assert!(!out.exists(), "{flag} {value}: wrote outputs");
     }
 }
+
+/// summary.json says which layout and blutrace wrote it, names every row of the
+/// luminance table, and reports the efficiency error the convergence history has.
+#[test]
+fn summary_is_versioned_labelled_and_agrees_with_the_history() {
+    let dir = tmp("summary");
+    let out = dir.path().join("o");
+    let run = blutrace(&[
+        "trace",
+        "scenes/notebook14",
+        "--photons",
+        "200000",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["schema_version"], 2);
+    assert_eq!(s["blutrace_version"], env!("CARGO_PKG_VERSION"));
+    assert!(s["figure_of_merit"]["per_s"].as_f64().unwrap() > 0.0);
+    let row = &s["luminance"]["by_theta"][0];
+    assert!(
+        row["theta_deg"].is_number() && row["cd_m2"].is_number(),
+        "{row}"
+    );
+    let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
+    let col = head.iter().position(|h| *h == "efficiency_stderr").unwrap();
+    let from_csv: f64 = last[col].parse().unwrap();
+    let from_summary = s["extraction_efficiency_stderr"].as_f64().unwrap();
+    assert!(
+        (from_csv - from_summary).abs() <= 1e-9 * from_summary,
+        "{from_csv} vs {from_summary}"
+    );
+}

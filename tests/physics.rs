@@ -356,7 +356,8 @@ fn lambertian_source_gives_uniform_luminance_equal_to_flux_over_pi_area() {
     let area_m2 = 2e7 * 2e7 * 1e-6;
     let expected = 100.0 / (std::f64::consts::PI * area_m2);
     assert!((lum.efficacy_lm_per_w - 100.0).abs() < 1e-12);
-    for [theta, value, se] in lum.by_theta {
+    for row in lum.by_theta {
+        let (theta, value, se) = (row.theta_deg, row.cd_m2, row.stderr_cd_m2);
         assert!(
             (value - expected).abs() < 4.0 * se,
             "theta {theta}: {value:.4e} ± {se:.1e}, expected {expected:.4e}"

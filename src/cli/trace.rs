@@ -184,7 +184,7 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     println!(
         "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {} ({:?})",
         s.mean_rel_stderr,
-        err(s.figure_of_merit.efficiency, 3, true),
+        err(s.figure_of_merit.per_s, 3, true),
         s.figure_of_merit.metric
     );
     if let Some(lum) = &s.luminance {

@@ -364,10 +364,14 @@ pub fn jackknife(scene: &Scene, groups: &[Tally]) -> MetricValues {
 }
 
 /// Every metric of the tally `total` and its standard error (jackknife over `groups`,
-/// the same photons split by chunk); the per-bin metric, itself an error, gets none.
+/// the same photons split by chunk); the per-bin metric, itself an error, gets none. The
+/// efficiency, a mean over photons, gets its exact per-photon error, the one the summary
+/// reports, so the convergence history and the summary agree.
 pub fn with_errors(scene: &Scene, total: &Tally, groups: &[Tally]) -> (MetricValues, MetricValues) {
     let values = Metrics::of(scene, total).values();
     let mut stderr = jackknife(scene, groups);
     stderr[Metric::MeanRelStderr] = 0.0;
+    let l = &total.ledger;
+    stderr[Metric::Efficiency] = l.detected.mean_and_stderr(l.photons).1;
     (values, stderr)
 }

@@ -10,9 +10,18 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
+/// Version of the summary.json layout: 2 added the versions, renamed
+/// `figure_of_merit.efficiency` to `figure_of_merit.per_s` and made `luminance.by_theta` a
+/// list of objects.
+pub const SCHEMA_VERSION: u32 = 2;
+
 /// summary.json.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
+    /// Version of this file's layout (bumped when a key changes meaning or name).
+    pub schema_version: u32,
+    /// The blutrace that wrote it.
+    pub blutrace_version: &'static str,
     /// Scene name.
     pub scene: String,
     /// Scene file path.
@@ -71,8 +80,8 @@ pub struct FigureOfMerit {
     pub metric: TargetMetric,
     /// Its relative standard error.
     pub rel_error: f64,
-    /// `1 / (rel_error^2 * runtime_s)`.
-    pub efficiency: f64,
+    /// `1 / (rel_error^2 * runtime_s)` (1/s): how fast the run buys accuracy.
+    pub per_s: f64,
 }
 
 /// Luminance of the target (cd/m^2, averaged over its area) against viewing angle.
@@ -84,8 +93,19 @@ pub struct LuminanceSummary {
     pub on_axis_cd_m2: f64,
     /// Its standard error.
     pub on_axis_stderr_cd_m2: f64,
-    /// Rows of [theta centre (deg), luminance (cd/m^2), standard error], averaged over phi.
-    pub by_theta: Vec<[f64; 3]>,
+    /// Luminance per theta row, averaged over phi.
+    pub by_theta: Vec<ThetaLuminance>,
+}
+
+/// Luminance of one theta row of the angular bins.
+#[derive(Clone, Debug, Serialize)]
+pub struct ThetaLuminance {
+    /// Centre of the row (degrees from the detector normal).
+    pub theta_deg: f64,
+    /// Luminance averaged over phi and over the target (cd/m^2).
+    pub cd_m2: f64,
+    /// Its standard error (cd/m^2).
+    pub stderr_cd_m2: f64,
 }
 
 /// The energy ledger in watts.
@@ -153,6 +173,8 @@ impl RunResult<'_> {
         );
         let runtime = self.runtime_s.max(1e-9);
         Summary {
+            schema_version: SCHEMA_VERSION,
+            blutrace_version: env!("CARGO_PKG_VERSION"),
             scene: self.scene.name.clone(),
             scene_file: self.scene.path.display().to_string(),
             backend: self.backend.to_string(),
@@ -194,14 +216,21 @@ impl RunResult<'_> {
             figure_of_merit: FigureOfMerit {
                 metric: target,
                 rel_error: rel,
-                efficiency: 1.0 / (rel * rel * runtime),
+                per_s: 1.0 / (rel * rel * runtime),
             },
             luminance: super::metrics::luminance_by_theta(self.scene, &self.tally).map(|rows| {
                 LuminanceSummary {
                     efficacy_lm_per_w: self.scene.sources.luminous_efficacy().unwrap_or(f64::NAN),
                     on_axis_cd_m2: rows[0][1],
                     on_axis_stderr_cd_m2: rows[0][2],
-                    by_theta: rows,
+                    by_theta: rows
+                        .iter()
+                        .map(|&[theta_deg, cd_m2, stderr_cd_m2]| ThetaLuminance {
+                            theta_deg,
+                            cd_m2,
+                            stderr_cd_m2,
+                        })
+                        .collect(),
                 }
             }),
             detector: DetectorSummary {

@@ -57,10 +57,12 @@ pub struct StagedDir {
 }
 
 impl StagedDir {
-    /// Prepare to write files into `dir`, creating it (and its parents) if needed.
+    /// Prepare to write files into `dir`, creating it (and its parents) if needed, and
+    /// remove the temporaries that killed runs left there (see [`remove_stale`]).
     pub fn new(dir: &Path) -> Result<Self> {
         fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        remove_stale(dir);
         Ok(Self {
             dir: dir.to_path_buf(),
             staged: Vec::new(),
@@ -193,6 +195,39 @@ impl Drop for StagedDir {
 }
 
 /// `name` is a single normal path component.
+/// Remove the temporaries (`.NAME.tmp-PID-N`) in `dir` whose process is gone: what a run
+/// killed while writing (SIGKILL, power loss) left behind, which no `Drop` could delete.
+/// A live process's temporaries are left alone (Linux: `/proc/PID` exists; elsewhere only
+/// this process's own are known to be alive, so nothing of another PID is kept). Runs on
+/// other machines writing into the same shared folder at the same time cannot be seen:
+/// give every run (every shard) its own output folder, as `trace --shard` usage does.
+pub fn remove_stale(dir: &Path) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let me = std::process::id();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = stale_pid(&name) else {
+            continue;
+        };
+        let alive = pid == me || Path::new(&format!("/proc/{pid}")).exists();
+        if !alive {
+            let p = e.path();
+            let _ = fs::remove_dir_all(&p).or_else(|_| fs::remove_file(&p));
+        }
+    }
+}
+
+/// The PID in a temporary name `.NAME.tmp-PID-N`, if `name` is one.
+fn stale_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix('.')?;
+    let (_, tail) = rest.rsplit_once(".tmp-")?;
+    let (pid, n) = tail.split_once('-')?;
+    n.parse::<u64>().ok()?;
+    pid.parse().ok()
+}
+
 fn is_plain_file_name(name: &str) -> bool {
     let mut components = Path::new(name).components();
     matches!((components.next(), components.next()), (Some(Component::Normal(c)), None) if c == name)
@@ -331,5 +366,27 @@ mod tests {
             assert!(s.commit().is_err(), "{bad:?} accepted");
             assert!(t.listing().is_empty(), "{bad:?}: {:?}", t.listing());
         }
+    }
+
+    #[test]
+    fn temporaries_of_dead_runs_are_removed_and_live_ones_kept() {
+        let t = TestDir::new("stale");
+        fs::create_dir_all(&t.0).unwrap();
+        // PID 2^31 - 1 is above Linux's pid_max: never a live process.
+        let dead = t.0.join(".flux.exr.tmp-2147483647-3");
+        let dead_dir = t.0.join(".final.tmp-2147483647-4");
+        let mine =
+            t.0.join(format!(".summary.json.tmp-{}-9", std::process::id()));
+        let other = t.0.join(".notes.tmp-x-1");
+        fs::write(&dead, b"half").unwrap();
+        fs::create_dir(&dead_dir).unwrap();
+        fs::write(dead_dir.join("a"), b"x").unwrap();
+        fs::write(&mine, b"in progress").unwrap();
+        fs::write(&other, b"not ours").unwrap();
+        let _s = StagedDir::new(&t.0).unwrap();
+        assert!(!dead.exists() && !dead_dir.exists());
+        assert!(mine.exists() && other.exists());
+        assert_eq!(stale_pid(".flux.exr.tmp-12-0"), Some(12));
+        assert_eq!(stale_pid("flux.exr"), None);
     }
 }

@@ -196,7 +196,9 @@ fn exported_dots_round_trip_to_the_density() {
             dots.iter()
                 .all(|d| (0.0..=30.0).contains(&d.x) && (0.0..=12.0).contains(&d.y))
         );
-        let csv = export::to_csv(&dots);
+        let frame = export::SheetFrame::of_face(&p, &rectangle(), DVec3::ZERO);
+        assert_eq!(frame.corner, DVec2::ZERO);
+        let csv = export::to_csv(&dots, &frame);
         let back = export::parse_csv(&csv).unwrap();
         assert_eq!(back.len(), dots.len());
         // Rows with centres on the face (y = (j + 1/2) h <= 12): 24 square, 28 hex.
@@ -317,14 +319,16 @@ fn density_grid_is_bilinear_at_cell_centres_and_covers_its_area_fraction() {
 fn svg_and_dxf_hold_every_dot() {
     let p = pattern(Lattice::Hex, Density::Polynomial(vec![0.2]));
     let dots = export::dots_on_face(&p, &rectangle());
-    let svg = export::to_svg(&dots);
+    let frame = export::SheetFrame::of_face(&p, &rectangle(), DVec3::ZERO);
+    let svg = export::to_svg(&dots, &frame);
     assert_eq!(svg.matches("<circle ").count(), dots.len());
     assert!(svg.starts_with("<?xml") && svg.trim_end().ends_with("</svg>"));
-    let dxf = export::to_dxf(&dots);
+    let dxf = export::to_dxf(&dots, &frame);
     assert_eq!(dxf.matches("\nCIRCLE\n").count(), dots.len());
     assert!(dxf.ends_with("0\nEOF\n"));
-    // Radii in the DXF: group code 40 follows every circle.
-    let radii: Vec<f64> = dxf
+    // Radii in the DXF's entities: group code 40 follows every circle.
+    let (_, entities) = dxf.split_once("ENTITIES\n").unwrap();
+    let radii: Vec<f64> = entities
         .lines()
         .collect::<Vec<_>>()
         .windows(2)
@@ -334,6 +338,79 @@ fn svg_and_dxf_hold_every_dot() {
     assert_eq!(radii.len(), dots.len());
     let r = Lattice::Hex.dot_radius(0.5, 0.2);
     assert!(radii.iter().all(|v| (v - r).abs() < 1e-5));
+}
+
+/// Exports are in the sheet's frame: a face whose across coordinates are all negative
+/// (as notebook14's back face is: y from -215 to 0 mm) is written from 0 up, with the
+/// frame in the header; the DXF declares its layer and reads in ezdxf when it is installed.
+#[test]
+fn exports_use_the_sheet_frame_with_positive_coordinates() {
+    let p = pattern(Lattice::Square, Density::Polynomial(vec![0.3]));
+    let below: Vec<[DVec3; 3]> = rectangle()
+        .iter()
+        .map(|t| t.map(|v| v - DVec3::new(0.0, 12.0, 0.0)))
+        .collect();
+    let dots = export::dots_on_face(&p, &below);
+    assert!(dots.iter().all(|d| d.y < 0.0));
+    let offset = DVec3::new(100.0, 0.0, 0.0);
+    let frame = export::SheetFrame::of_face(&p, &below, offset);
+    assert_eq!(frame.origin, DVec3::new(100.0, -12.0, 0.0));
+    let csv = export::to_csv(&dots, &frame);
+    assert!(
+        csv.starts_with("# blutrace dot pattern: units mm"),
+        "{csv:.200}"
+    );
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .contains("(100.0000, -12.0000, 0.0000)")
+    );
+    let sheet = export::parse_csv(&csv).unwrap();
+    assert!(
+        sheet
+            .iter()
+            .all(|d| (0.0..=30.0).contains(&d.x) && (0.0..=12.0).contains(&d.y))
+    );
+    for (a, b) in sheet.iter().zip(&dots) {
+        assert!((a.y - (b.y + 12.0)).abs() < 1e-4 && (a.x - b.x).abs() < 1e-4);
+    }
+    let dxf = export::to_dxf(&dots, &frame);
+    assert!(dxf.contains("0\nTABLE\n2\nLAYER\n") && dxf.contains("0\nLAYER\n2\nDOTS\n"));
+    assert!(
+        !dxf.contains("$INSUNITS"),
+        "R12 readers do not know $INSUNITS"
+    );
+    let has_ezdxf = std::process::Command::new("python3")
+        .args(["-c", "import ezdxf"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has_ezdxf {
+        eprintln!("ezdxf not installed: DXF read-back skipped (pip install ezdxf)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dots.dxf");
+    std::fs::write(&path, &dxf).unwrap();
+    let script = "import sys, ezdxf\n\
+                  doc = ezdxf.readfile(sys.argv[1])\n\
+                  c = doc.modelspace().query('CIRCLE')\n\
+                  assert 'DOTS' in doc.layers, 'layer DOTS not declared'\n\
+                  assert all(e.dxf.layer == 'DOTS' for e in c)\n\
+                  print(len(c), min(e.dxf.center.y for e in c))";
+    let out = std::process::Command::new("python3")
+        .args(["-c", script, path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut it = text.split_whitespace();
+    assert_eq!(it.next().unwrap().parse::<usize>().unwrap(), dots.len());
+    assert!(it.next().unwrap().parse::<f64>().unwrap() >= 0.0);
 }
 
 const LED: &str = "[[sources]]\ntype = \"led\"\ncenter = [-20.001, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\n\

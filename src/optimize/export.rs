@@ -5,20 +5,24 @@
 //! blutrace optimize SCENE --out DIR   # writes DIR/dots.csv, DIR/dots.svg, DIR/dots.dxf
 //! ```
 //!
-//! Coordinates are the face coordinates of the dot pattern, in mm: `x` along the
-//! pattern's `axis` and `y` along its `across` direction, both from its `origin`:
+//! Coordinates (mm) are written in the printed sheet's frame ([`SheetFrame`]): `x` along the
+//! pattern's `axis` (away from the lamp edge), `y` along its `across` direction, both from
+//! the corner of the face where they are smallest, so every coordinate is >= 0. Each file
+//! states the frame in its header: the corner's position and the two directions in the
+//! scene file's coordinates.
 //!
 //! ```toml
 //! [surfaces.lgp_back]
 //! model = "dots"
-//! origin = [0.0, 0.0, 0.0]   # dots.csv (x, y) = (0, 0) here
+//! origin = [0.0, 0.0, 0.0]   # a point on the lamp edge
 //! axis = [1.0, 0.0, 0.0]     # dots.csv x
 //! ```
 //!
 //! A dot is listed when its centre lies on the face (inside one of the tag's triangles);
 //! its diameter is `2 sqrt(d(x) A / pi)` with `A` the cell area, so the dots cover the
 //! fraction `d(x)` of the face around `x`. The DXF is plain R12 ASCII: one `CIRCLE`
-//! entity per dot on layer `DOTS`, in mm, readable by CAD and printer software.
+//! entity per dot on layer `DOTS` (declared in the `TABLES` section), in millimetres; R12
+//! has no units variable, so the units and the frame are stated in `999` comments.
 
 use crate::optics::dots::DotPattern;
 use anyhow::{Context, Result, bail};
@@ -35,6 +39,56 @@ pub struct Dot {
     pub y: f64,
     /// Diameter (mm).
     pub diameter: f64,
+}
+
+/// The frame of the printed sheet: where its (0, 0) is and where its axes point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SheetFrame {
+    /// The face corner in pattern face coordinates (mm along `axis`, mm along `across`):
+    /// subtracted from every dot.
+    pub corner: DVec2,
+    /// That corner in the scene file's coordinates (mm).
+    pub origin: DVec3,
+    /// Unit direction of the sheet's x (the pattern's axis).
+    pub x: DVec3,
+    /// Unit direction of the sheet's y (the pattern's across direction).
+    pub y: DVec3,
+}
+
+impl SheetFrame {
+    /// The frame of the face made of `triangles` (scene coordinates, recentred by
+    /// `offset`: file = scene + offset): its corner where both face coordinates are least.
+    pub fn of_face(pattern: &DotPattern, triangles: &[[DVec3; 3]], offset: DVec3) -> Self {
+        let corner = triangles
+            .iter()
+            .flatten()
+            .map(|&v| pattern.face_coords(v))
+            .reduce(DVec2::min)
+            .unwrap_or(DVec2::ZERO);
+        SheetFrame {
+            corner,
+            origin: pattern.origin + pattern.axis * corner.x + pattern.across * corner.y + offset,
+            x: pattern.axis,
+            y: pattern.across,
+        }
+    }
+
+    /// A dot's position on the sheet (mm).
+    fn place(&self, d: &Dot) -> DVec2 {
+        DVec2::new(d.x - self.corner.x, d.y - self.corner.y)
+    }
+
+    /// One line saying what the coordinates mean.
+    fn describe(&self) -> String {
+        let v = |p: DVec3| format!("({:.4}, {:.4}, {:.4})", p.x, p.y, p.z);
+        format!(
+            "units mm; sheet x along {} and y along {} (the dot pattern's axis and across \
+             directions), from the face corner at {} mm in the scene file's frame",
+            v(self.x),
+            v(self.y),
+            v(self.origin)
+        )
+    }
 }
 
 /// Every dot whose centre lies on the face made of `triangles` (scene coordinates, the
@@ -82,37 +136,42 @@ fn inside_triangle(p: DVec2, t: [DVec2; 3]) -> bool {
     s.iter().all(|&v| v >= -eps) || s.iter().all(|&v| v <= eps)
 }
 
-/// `x_mm,y_mm,diameter_mm` with a header line, positions to 0.1 um.
-pub fn to_csv(dots: &[Dot]) -> String {
-    let mut s = String::with_capacity(32 * dots.len() + 32);
+/// `x_mm,y_mm,diameter_mm` on the sheet, after a `#` line stating the frame, positions to
+/// 0.1 um.
+pub fn to_csv(dots: &[Dot], frame: &SheetFrame) -> String {
+    let mut s = String::with_capacity(32 * dots.len() + 256);
+    let _ = writeln!(s, "# blutrace dot pattern: {}", frame.describe());
     s.push_str("x_mm,y_mm,diameter_mm\n");
     for d in dots {
-        let _ = writeln!(s, "{:.4},{:.4},{:.5}", d.x, d.y, d.diameter);
+        let p = frame.place(d);
+        let _ = writeln!(s, "{:.4},{:.4},{:.5}", p.x, p.y, d.diameter);
     }
     s
 }
 
-/// Read back what [`to_csv`] wrote.
+/// Read back what [`to_csv`] wrote (sheet coordinates; `#` lines are comments).
 pub fn parse_csv(text: &str) -> Result<Vec<Dot>> {
-    let mut lines = text.lines();
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim_start().starts_with('#'));
     match lines.next() {
-        Some(h) if h.trim() == "x_mm,y_mm,diameter_mm" => {}
+        Some((_, h)) if h.trim() == "x_mm,y_mm,diameter_mm" => {}
         _ => bail!("dots CSV: expected the header x_mm,y_mm,diameter_mm"),
     }
     lines
-        .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
             let v: Vec<f64> = l
                 .split(',')
                 .map(|f| f.trim().parse::<f64>())
                 .collect::<std::result::Result<_, _>>()
-                .with_context(|| format!("dots CSV line {}: not three numbers", i + 2))?;
+                .with_context(|| format!("dots CSV line {}: not three numbers", i + 1))?;
             match v[..] {
                 [x, y, diameter] => Ok(Dot { x, y, diameter }),
                 _ => bail!(
                     "dots CSV line {}: expected 3 fields, got {}",
-                    i + 2,
+                    i + 1,
                     v.len()
                 ),
             }
@@ -120,13 +179,13 @@ pub fn parse_csv(text: &str) -> Result<Vec<Dot>> {
         .collect()
 }
 
-/// An SVG drawing of the dots in mm (1 user unit = 1 mm), face `y` pointing up.
-pub fn to_svg(dots: &[Dot]) -> String {
+/// An SVG drawing of the dots on the sheet in mm (1 user unit = 1 mm), sheet `y` up.
+pub fn to_svg(dots: &[Dot], frame: &SheetFrame) -> String {
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     for d in dots {
-        let r = 0.5 * d.diameter;
-        lo = lo.min(DVec2::new(d.x - r, d.y - r));
-        hi = hi.max(DVec2::new(d.x + r, d.y + r));
+        let (r, p) = (0.5 * d.diameter, frame.place(d));
+        lo = lo.min(DVec2::new(p.x - r, p.y - r));
+        hi = hi.max(DVec2::new(p.x + r, p.y + r));
     }
     if dots.is_empty() {
         (lo, hi) = (DVec2::ZERO, DVec2::ONE);
@@ -144,16 +203,18 @@ pub fn to_svg(dots: &[Dot]) -> String {
     );
     let _ = writeln!(
         s,
-        "<!-- blutrace dot pattern: {} dots; x along the pattern axis, y across it (mm) -->",
-        dots.len()
+        "<!-- blutrace dot pattern: {} dots; {} -->",
+        dots.len(),
+        frame.describe()
     );
     s.push_str("<g transform=\"scale(1,-1)\" fill=\"black\" stroke=\"none\">\n");
     for d in dots {
+        let p = frame.place(d);
         let _ = writeln!(
             s,
             "<circle cx=\"{:.4}\" cy=\"{:.4}\" r=\"{:.5}\"/>",
-            d.x,
-            d.y,
+            p.x,
+            p.y,
             0.5 * d.diameter
         );
     }
@@ -161,17 +222,33 @@ pub fn to_svg(dots: &[Dot]) -> String {
     s
 }
 
-/// A minimal ASCII DXF (R12): one `CIRCLE` per dot on layer `DOTS`, units mm.
-pub fn to_dxf(dots: &[Dot]) -> String {
-    let mut s = String::with_capacity(64 * dots.len() + 256);
-    s.push_str("0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n");
+/// A minimal ASCII DXF (R12): the layer `DOTS` declared, one `CIRCLE` per dot on it, in
+/// mm on the sheet; units and frame in `999` comments.
+pub fn to_dxf(dots: &[Dot], frame: &SheetFrame) -> String {
+    let mut s = String::with_capacity(64 * dots.len() + 1024);
+    let _ = write!(
+        s,
+        "999\nblutrace dot pattern, {} dots\n999\n{}\n",
+        dots.len(),
+        frame.describe()
+    );
+    s.push_str(concat!(
+        "0\nSECTION\n2\nTABLES\n",
+        "0\nTABLE\n2\nLTYPE\n70\n1\n",
+        "0\nLTYPE\n2\nCONTINUOUS\n70\n0\n3\nSolid line\n72\n65\n73\n0\n40\n0.0\n",
+        "0\nENDTAB\n",
+        "0\nTABLE\n2\nLAYER\n70\n1\n",
+        "0\nLAYER\n2\nDOTS\n70\n0\n62\n7\n6\nCONTINUOUS\n",
+        "0\nENDTAB\n0\nENDSEC\n",
+    ));
     s.push_str("0\nSECTION\n2\nENTITIES\n");
     for d in dots {
+        let p = frame.place(d);
         let _ = write!(
             s,
             "0\nCIRCLE\n8\nDOTS\n10\n{:.4}\n20\n{:.4}\n30\n0.0\n40\n{:.5}\n",
-            d.x,
-            d.y,
+            p.x,
+            p.y,
             0.5 * d.diameter
         );
     }

@@ -91,7 +91,9 @@ pub fn optimize(
     };
     let mut pattern = search.pattern.clone();
     pattern.density = final_density.clone();
-    let dots = export::dots_on_face(&pattern, &search.face_triangles());
+    let face = search.face_triangles();
+    let dots = export::dots_on_face(&pattern, &face);
+    let sheet = export::SheetFrame::of_face(&pattern, &face, search.scene.offset);
     let (initial_run, final_run, verification) =
         match verify::verify(&search, &initial_density, &final_density)? {
             Some((i, f, v)) => (i, f, Some(v)),
@@ -114,6 +116,7 @@ pub fn optimize(
         best: best_ev,
         verification,
         dots,
+        sheet,
         pattern,
         initial_run,
         final_run,

@@ -1,6 +1,6 @@
 //! The outcome of an optimization: designs, history, verification.
 
-use super::export::Dot;
+use super::export::{Dot, SheetFrame};
 use super::objective::Evaluation;
 use super::report::IterationReport;
 use super::traced::TracedRun;
@@ -67,9 +67,12 @@ pub struct OptimizeResult {
     pub best: Evaluation,
     /// The re-traces with a fresh seed (None with `verify_photons = 0`).
     pub verification: Option<Verification>,
-    /// Every dot of the final pattern.
+    /// Every dot of the final pattern (face coordinates).
     #[serde(skip)]
     pub dots: Vec<Dot>,
+    /// The printed sheet's frame the exports use.
+    #[serde(skip)]
+    pub sheet: SheetFrame,
     /// The final pattern (scene frame).
     #[serde(skip)]
     pub pattern: DotPattern,

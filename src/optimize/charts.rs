@@ -99,7 +99,8 @@ fn write_density_map(path: &Path, g: &DensityGrid) -> Result<()> {
     let values: Vec<f64> = g.values.iter().flatten().copied().collect();
     let opts = PreviewOptions {
         min: Some(0.0),
-        max: None,
+        unit: Some("area fraction"),
+        ..PreviewOptions::default()
     };
     write_false_colour(path, nx, ny, &values, &opts)
 }

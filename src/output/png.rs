@@ -25,6 +25,11 @@ pub struct PreviewOptions {
     /// Value drawn with the brightest colour; default: the largest finite value (or `min`
     /// if that is larger).
     pub max: Option<f64>,
+    /// The grid's physical size (mm along x, along y): the map keeps its aspect ratio and
+    /// gets axes with ticks in mm. None: square bins, no axes.
+    pub extent_mm: Option<[f64; 2]>,
+    /// The values' unit, written above the colour bar.
+    pub unit: Option<&'static str>,
 }
 
 /// Colour of bins without a meaningful value.
@@ -73,7 +78,7 @@ pub fn write_false_colour(
 ) -> Result<()> {
     let what = || format!("cannot write PNG preview {}", path.display());
     let (lo, hi) = value_range(values, opts).with_context(what)?;
-    let (w, h, rgb) = render(width, height, values, lo, hi).with_context(what)?;
+    let (w, h, rgb) = render(width, height, values, (lo, hi), opts).with_context(what)?;
     let comment = format!(
         "viridis false colour of a {width}x{height} grid, range {lo} to {hi}, \
          grid row 0 at the bottom, grey = no value"
@@ -139,18 +144,36 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(width: usize, height: usize) -> Self {
-        let longest = width.max(height);
-        let scale = TARGET_SIDE.div_ceil(longest).max(1);
-        let (map_w, map_h) = (width * scale, height * scale);
+    fn new(width: usize, height: usize, opts: &PreviewOptions) -> Self {
+        let (map_w, map_h, scale) = match opts.extent_mm {
+            // Physical aspect: the longer side TARGET_SIDE pixels, bins resampled.
+            Some([ex, ey]) => {
+                let long = ex.max(ey);
+                let side = |e: f64| ((TARGET_SIDE as f64 * e / long).round() as usize).max(1);
+                (side(ex), side(ey), 0)
+            }
+            None => {
+                let scale = TARGET_SIDE.div_ceil(width.max(height)).max(1);
+                (width * scale, height * scale, scale)
+            }
+        };
+        let axes = opts.extent_mm.is_some();
+        // Room for the y tick labels left of the map and the x ones below it.
+        let left = if axes {
+            AXIS_LABEL_CHARS * CHAR_W + TICK + LABEL_GAP
+        } else {
+            0
+        };
+        let below = if axes { TICK + 4 + CHAR_H } else { 0 };
+        let unit_h = if opts.unit.is_some() { CHAR_H + 8 } else { 0 };
         let content_h = map_h.max(BAR_MIN_H);
-        let map_x = MARGIN;
-        let map_y = MARGIN + (content_h - map_h) / 2;
+        let map_x = MARGIN + left;
+        let map_y = MARGIN + unit_h + (content_h - map_h) / 2;
         let bar_x = map_x + map_w + GAP;
-        let bar_y = MARGIN;
+        let bar_y = MARGIN + unit_h;
         let label_x = bar_x + BAR_W + TICK + LABEL_GAP;
         let image_w = label_x + LABEL_CHARS * CHAR_W + MARGIN;
-        let image_h = MARGIN + content_h + MARGIN;
+        let image_h = MARGIN + unit_h + content_h + below + MARGIN;
         Self {
             scale,
             map_x,
@@ -165,6 +188,33 @@ impl Layout {
             image_h,
         }
     }
+}
+
+/// Characters kept for a mm tick label left of the map.
+const AXIS_LABEL_CHARS: usize = 6;
+
+/// Tick positions for `0..=range`: a step of 1, 2 or 5 times a power of ten giving about
+/// five intervals, and the step.
+fn mm_ticks(range: f64) -> (Vec<f64>, f64) {
+    let raw = range / 5.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * mag);
+    let n = (range / step + 1e-9).floor() as usize;
+    ((0..=n).map(|k| k as f64 * step).collect(), step)
+}
+
+/// A tick label in mm with as many decimals as the step needs.
+fn mm_label(v: f64, step: f64) -> String {
+    let decimals = if step >= 1.0 {
+        0
+    } else {
+        (-step.log10().floor()) as usize
+    };
+    format!("{v:.decimals$}")
 }
 
 /// An RGB canvas.
@@ -225,13 +275,13 @@ impl Canvas {
 }
 
 /// Render the preview: `(image width, image height, 8-bit RGB pixels)`.
-/// `lo..=hi` is the colour range from [`value_range`].
+/// `(lo, hi)` is the colour range from [`value_range`].
 fn render(
     width: usize,
     height: usize,
     values: &[f64],
-    lo: f64,
-    hi: f64,
+    (lo, hi): (f64, f64),
+    opts: &PreviewOptions,
 ) -> Result<(u32, u32, Vec<u8>)> {
     ensure!(width > 0 && height > 0, "empty grid ({width} × {height})");
     let count = width
@@ -246,6 +296,12 @@ fn render(
         width <= 1 << 14 && height <= 1 << 14,
         "grid {width} × {height} is too large for a preview (at most 16384 bins per side)"
     );
+    if let Some(e) = opts.extent_mm {
+        ensure!(
+            e.iter().all(|v| v.is_finite() && *v > 0.0),
+            "preview extent {e:?} mm is not positive"
+        );
+    }
     let span = hi - lo;
     let colour = |v: f64| -> [u8; 3] {
         if !is_drawable(v, lo) {
@@ -257,25 +313,38 @@ fn render(
         }
     };
 
-    let l = Layout::new(width, height);
+    let l = Layout::new(width, height, opts);
     let mut canvas = Canvas::new(l.image_w, l.image_h, BACKGROUND);
 
-    // The map, grid row 0 at the bottom.
-    for (gy, row) in values.chunks_exact(width).enumerate() {
-        let py = l.map_y + (height - 1 - gy) * l.scale;
-        for (gx, &v) in row.iter().enumerate() {
-            canvas.fill_rect(l.map_x + gx * l.scale, py, l.scale, l.scale, colour(v));
+    // The map, grid row 0 at the bottom: each pixel shows the bin it falls in.
+    for py in 0..l.map_h {
+        let gy = height - 1 - py * height / l.map_h;
+        for px in 0..l.map_w {
+            let gx = px * width / l.map_w;
+            canvas.fill_rect(
+                l.map_x + px,
+                l.map_y + py,
+                1,
+                1,
+                colour(values[gy * width + gx]),
+            );
         }
     }
     canvas.frame(l.map_x, l.map_y, l.map_w, l.map_h, FRAME);
+    if let Some([ex, ey]) = opts.extent_mm {
+        draw_mm_axes(&mut canvas, &l, ex, ey);
+    }
 
-    // The colour bar, `hi` at the top.
+    // The colour bar, `hi` at the top, its unit above it.
     let denom = (l.bar_h - 1) as f64;
     for j in 0..l.bar_h {
         let t = 1.0 - j as f64 / denom;
         canvas.fill_rect(l.bar_x, l.bar_y + j, BAR_W, 1, viridis(t));
     }
     canvas.frame(l.bar_x, l.bar_y, BAR_W, l.bar_h, FRAME);
+    if let Some(unit) = opts.unit {
+        canvas.text(l.bar_x, l.bar_y - CHAR_H - 6, unit, INK);
+    }
 
     // Ticks and labels at the top, middle and bottom of the bar.
     let ticks = [(0, hi), (l.bar_h / 2, 0.5 * (lo + hi)), (l.bar_h - 1, lo)];
@@ -289,6 +358,28 @@ fn render(
     let w = u32::try_from(l.image_w).context("preview too wide")?;
     let h = u32::try_from(l.image_h).context("preview too tall")?;
     Ok((w, h, canvas.rgb))
+}
+
+/// Ticks in mm below the map (x) and left of it (y), labelled from 0 at the lower left.
+fn draw_mm_axes(canvas: &mut Canvas, l: &Layout, ex: f64, ey: f64) {
+    let (xt, xs) = mm_ticks(ex);
+    for v in xt {
+        let px = l.map_x + ((v / ex) * (l.map_w - 1) as f64).round() as usize;
+        canvas.fill_rect(px, l.map_y + l.map_h + 1, 1, TICK, FRAME);
+        let label = mm_label(v, xs);
+        let x = px.saturating_sub(label.len() * CHAR_W / 2);
+        canvas.text(x, l.map_y + l.map_h + TICK + 4, &label, INK);
+    }
+    // The unit, in the free corner below the y labels and left of the x ones.
+    canvas.text(MARGIN, l.map_y + l.map_h + TICK + 4, "mm", INK);
+    let (yt, ys) = mm_ticks(ey);
+    for v in yt {
+        let py = l.map_y + l.map_h - 1 - ((v / ey) * (l.map_h - 1) as f64).round() as usize;
+        canvas.fill_rect(l.map_x - 1 - TICK, py, TICK, 1, FRAME);
+        let label = mm_label(v, ys);
+        let x = (l.map_x - 1 - TICK - LABEL_GAP / 2).saturating_sub(label.len() * CHAR_W);
+        canvas.text(x, (py + 1).saturating_sub(CHAR_H / 2), &label, INK);
+    }
 }
 
 #[cfg(test)]
@@ -337,7 +428,7 @@ mod tests {
         write_false_colour(&f.0, w, h, &v, &PreviewOptions::default()).unwrap();
         let img = decode(&f.0);
 
-        let l = Layout::new(w, h);
+        let l = Layout::new(w, h, &PreviewOptions::default());
         assert_eq!(l.scale, 15);
         assert_eq!((l.map_w, l.map_h), (600, 300));
         assert_eq!((img.0 as usize, img.1 as usize), (l.image_w, l.image_h));
@@ -365,10 +456,11 @@ mod tests {
         let opts = PreviewOptions {
             min: Some(-1.0),
             max: Some(1.0),
+            ..PreviewOptions::default()
         };
         write_false_colour(&f.0, 3, 2, &v, &opts).unwrap();
         let img = decode(&f.0);
-        let l = Layout::new(3, 2);
+        let l = Layout::new(3, 2, &opts);
         assert_eq!(l.scale, 200);
         let s = l.scale;
         // Grid row 0 (-1, 0, 0.5) at the bottom; negative values are valid with min < 0.
@@ -378,7 +470,7 @@ mod tests {
         assert_eq!(pixel(&img, l.map_x + 2 * s, l.map_y), INVALID_GREY); // +inf
 
         for (w, h) in [(1, 1), (1000, 3), (3, 1000), (799, 800), (301, 1)] {
-            let l = Layout::new(w, h);
+            let l = Layout::new(w, h, &PreviewOptions::default());
             let side = l.map_w.max(l.map_h);
             assert!(
                 side >= 600.min(w.max(h)) && (side < 800 || l.scale == 1),
@@ -396,11 +488,13 @@ mod tests {
         let bad = PreviewOptions {
             min: Some(2.0),
             max: Some(1.0),
+            ..PreviewOptions::default()
         };
         assert!(write_false_colour(&f.0, 1, 1, &[0.0], &bad).is_err());
         let bad = PreviewOptions {
             min: Some(f64::NAN),
             max: None,
+            ..PreviewOptions::default()
         };
         assert!(write_false_colour(&f.0, 1, 1, &[0.0], &bad).is_err());
         assert!(!f.0.exists());
@@ -432,6 +526,7 @@ mod tests {
         let opts = PreviewOptions {
             min: Some(-5e-7),
             max: None,
+            ..PreviewOptions::default()
         };
         write_false_colour(
             Path::new("/tmp/blutrace_preview_small.png"),
@@ -441,5 +536,36 @@ mod tests {
             &opts,
         )
         .unwrap();
+    }
+
+    #[test]
+    fn physical_previews_keep_the_aspect_ratio_and_label_mm() {
+        assert_eq!(mm_ticks(290.0), (vec![0.0, 100.0, 200.0], 100.0));
+        assert_eq!(mm_ticks(215.0).1, 50.0);
+        assert_eq!(mm_ticks(0.6).1, 0.2);
+        assert_eq!(mm_label(0.4, 0.2), "0.4");
+        assert_eq!(mm_label(150.0, 50.0), "150");
+        let opts = PreviewOptions {
+            extent_mm: Some([290.0, 215.0]),
+            unit: Some("W/mm^2"),
+            ..PreviewOptions::default()
+        };
+        // A 100 x 100 grid of a 290 x 215 mm target: the map is 290:215, not square.
+        let l = Layout::new(100, 100, &opts);
+        assert_eq!(l.map_w, TARGET_SIDE);
+        assert_eq!(
+            l.map_h,
+            (TARGET_SIDE as f64 * 215.0 / 290.0).round() as usize
+        );
+        let f = TempFile::new("physical");
+        let values: Vec<f64> = (0..100 * 100).map(|i| (i % 100) as f64).collect();
+        write_false_colour(&f.0, 100, 100, &values, &opts).unwrap();
+        let img = decode(&f.0);
+        assert_eq!(img.0 as usize, l.image_w);
+        // Left of the map is the brightest x = 0 column's opposite: the map's left edge
+        // shows column 0 (value 0, darkest), its right edge column 99 (brightest).
+        let y = l.map_y + l.map_h / 2;
+        assert_eq!(pixel(&img, l.map_x, y), viridis(0.0));
+        assert_eq!(pixel(&img, l.map_x + l.map_w - 1, y), viridis(1.0));
     }
 }

@@ -434,12 +434,17 @@ impl RunResult<'_> {
         let lum = metrics::luminance_map(self.scene, &self.tally);
         write_angular_exr(&mut staged, &ang, lum.as_ref(), &ang_attrs)?;
         let png = staged.stage_path("flux.png");
+        let d = &self.scene.detector;
         output::png::write_false_colour(
             &png,
             flux.nx,
             flux.ny,
             &flux.value,
-            &output::png::PreviewOptions::default(),
+            &output::png::PreviewOptions {
+                extent_mm: Some(d.size),
+                unit: Some("W/mm^2"),
+                ..Default::default()
+            },
         )?;
         staged.write_bytes(
             "convergence.csv",

@@ -20,3 +20,5 @@ pub mod exr;
 pub(crate) mod font;
 pub mod plot;
 pub mod png;
+#[cfg(test)]
+mod test_png;

@@ -1,33 +1,7 @@
 //! Tests of the chart writer: geometry of the axes, ticks, legend and the PNG itself.
 
 use super::*;
-use std::fs::File;
-use std::path::PathBuf;
-
-/// A path (not yet a file) in a fresh temporary folder, removed on drop.
-struct TempFile(PathBuf, #[allow(dead_code)] tempfile::TempDir);
-
-impl TempFile {
-    fn new(tag: &str) -> Self {
-        let dir = tempfile::Builder::new()
-            .prefix(&format!("blutrace-plot-{tag}-"))
-            .tempdir()
-            .unwrap();
-        Self(dir.path().join("file.png"), dir)
-    }
-}
-
-/// Decode an 8-bit RGB PNG: `(width, height, pixels)`.
-fn decode(path: &Path) -> (u32, u32, Vec<u8>) {
-    let file = std::io::BufReader::new(File::open(path).unwrap());
-    let mut reader = ::png::Decoder::new(file).read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, ::png::ColorType::Rgb);
-    assert_eq!(info.bit_depth, ::png::BitDepth::Eight);
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
-}
+use crate::output::test_png::{TempFile, decode};
 
 fn pixel(r: &Rendered, x: i64, y: i64) -> [u8; 3] {
     let i = 3 * (y * r.width + x) as usize;

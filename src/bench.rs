@@ -188,7 +188,7 @@ pub fn large_mesh_table(
     // The lamps' own emission: rays from the tubes into their reflector cavities.
     let mut rng = PhotonRng::new(11, 0);
     let rays: Vec<Ray> = (0..queries)
-        .map(|_| scene.sources.sample(&mut rng).0)
+        .map(|_| scene.sources.sample(&mut rng).ray)
         .collect();
     let accels: Vec<Box<dyn Accel>> = backends()
         .into_iter()

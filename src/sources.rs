@@ -27,6 +27,7 @@
 //! for the CSV and IES LM-63 formats and how the table is sampled.
 
 pub mod body;
+pub mod body_shape;
 pub mod intensity;
 
 use crate::geometry::{Ray, orthonormal_basis};
@@ -35,6 +36,7 @@ use crate::optics::sampling;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
+use body::{BodySpec, LampBody};
 use glam::DVec3;
 use intensity::IntensityProfile;
 use serde::{Deserialize, Serialize};
@@ -65,6 +67,9 @@ pub enum SourceSpec {
         /// Medium around the tube.
         #[serde(default = "air")]
         medium: String,
+        /// What light returning to the tube meets ([`body`]).
+        #[serde(default)]
+        body: BodySpec,
     },
     /// Flat LED emitter.
     Led {
@@ -95,6 +100,13 @@ pub enum SourceSpec {
         /// Medium in front of the emitter.
         #[serde(default = "air")]
         medium: String,
+        /// What light returning to the LED meets ([`body`]).
+        #[serde(default)]
+        body: BodySpec,
+        /// Depth of a box package behind the emitting rectangle (mm); without it the body
+        /// is the rectangle itself.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        package_depth_mm: Option<f64>,
     },
 }
 
@@ -103,40 +115,72 @@ impl SourceSpec {
     /// `intensity_file` is relative to the scene file).
     pub fn build(&self, ctx: &Ctx, i: usize, media: &[Medium]) -> Result<Source> {
         let f = |k: &str| format!("sources[{i}].{k}");
-        Ok(match self {
+        let (name, power_w, lumens, medium, body, depth) = match self {
             SourceSpec::Ccfl {
                 name,
+                power_w,
+                lumens,
+                medium,
+                body,
+                ..
+            } => (name, power_w, lumens, medium, body, None),
+            SourceSpec::Led {
+                name,
+                power_w,
+                lumens,
+                medium,
+                body,
+                package_depth_mm,
+                ..
+            } => (name, power_w, lumens, medium, body, *package_depth_mm),
+        };
+        let emitter = self.emitter(ctx, i)?;
+        let depth = depth
+            .map(|d| ctx.length(&f("package_depth_mm"), d))
+            .transpose()?;
+        let body = body
+            .model(ctx, &f("body"))?
+            .map(|model| LampBody::new(&emitter, model, depth));
+        let kind = if matches!(self, SourceSpec::Ccfl { .. }) {
+            "ccfl"
+        } else {
+            "led"
+        };
+        Ok(Source {
+            name: name.clone().unwrap_or_else(|| format!("{kind}{i}")),
+            power_w: ctx.positive(&f("power_w"), *power_w)?,
+            lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
+            emitter,
+            medium: medium_id(ctx, &f("medium"), medium, media)?,
+            body,
+        })
+    }
+
+    /// Check the emitting shape of entry `i` and build it.
+    fn emitter(&self, ctx: &Ctx, i: usize) -> Result<Emitter> {
+        let f = |k: &str| format!("sources[{i}].{k}");
+        Ok(match self {
+            SourceSpec::Ccfl {
                 center,
                 axis,
                 radius_mm,
                 length_mm,
-                power_w,
-                lumens,
-                medium,
-            } => Source {
-                name: name.clone().unwrap_or_else(|| format!("ccfl{i}")),
-                power_w: ctx.positive(&f("power_w"), *power_w)?,
-                lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
-                emitter: Emitter::Ccfl {
-                    center: ctx.point(&f("center"), *center)?,
-                    axis: ctx.direction(&f("axis"), *axis)?,
-                    radius: ctx.length(&f("radius_mm"), *radius_mm)?,
-                    length: ctx.length(&f("length_mm"), *length_mm)?,
-                },
-                medium: medium_id(ctx, &f("medium"), medium, media)?,
+                ..
+            } => Emitter::Ccfl {
+                center: ctx.point(&f("center"), *center)?,
+                axis: ctx.direction(&f("axis"), *axis)?,
+                radius: ctx.length(&f("radius_mm"), *radius_mm)?,
+                length: ctx.length(&f("length_mm"), *length_mm)?,
             },
             SourceSpec::Led {
-                name,
                 center,
                 normal,
                 u,
                 width_mm,
                 height_mm,
-                power_w,
-                lumens,
                 cos_exponent,
                 intensity_file,
-                medium,
+                ..
             } => {
                 let n = ctx.direction(&f("normal"), *normal)?;
                 let u = ctx.direction(&f("u"), *u)?;
@@ -148,40 +192,34 @@ impl SourceSpec {
                     ctx.length(&f("width_mm"), *width_mm)?,
                     ctx.length(&f("height_mm"), *height_mm)?,
                 );
-                Source {
-                    name: name.clone().unwrap_or_else(|| format!("led{i}")),
-                    power_w: ctx.positive(&f("power_w"), *power_w)?,
-                    lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
-                    emitter: match (intensity_file, cos_exponent) {
-                        (Some(_), Some(_)) => {
-                            return Err(ctx.err(
-                                &f("intensity_file"),
-                                "give either cos_exponent or intensity_file, not both",
-                            ));
-                        }
-                        (Some(file), None) => {
-                            let dir = ctx.0.parent().unwrap_or(Path::new("."));
-                            let profile = IntensityProfile::read(&dir.join(file))
-                                .map_err(|e| ctx.err(&f("intensity_file"), e))?;
-                            Emitter::MeasuredLed {
-                                center,
-                                normal: n,
-                                u,
-                                width,
-                                height,
-                                profile: Arc::new(profile),
-                            }
-                        }
-                        (None, m) => Emitter::Led {
+                match (intensity_file, cos_exponent) {
+                    (Some(_), Some(_)) => {
+                        return Err(ctx.err(
+                            &f("intensity_file"),
+                            "give either cos_exponent or intensity_file, not both",
+                        ));
+                    }
+                    (Some(file), None) => {
+                        let dir = ctx.0.parent().unwrap_or(Path::new("."));
+                        let profile = IntensityProfile::read(&dir.join(file))
+                            .map_err(|e| ctx.err(&f("intensity_file"), e))?;
+                        Emitter::MeasuredLed {
                             center,
                             normal: n,
                             u,
                             width,
                             height,
-                            cos_exponent: ctx.non_negative(&f("cos_exponent"), m.unwrap_or(1.0))?,
-                        },
+                            profile: Arc::new(profile),
+                        }
+                    }
+                    (None, m) => Emitter::Led {
+                        center,
+                        normal: n,
+                        u,
+                        width,
+                        height,
+                        cos_exponent: ctx.non_negative(&f("cos_exponent"), m.unwrap_or(1.0))?,
                     },
-                    medium: medium_id(ctx, &f("medium"), medium, media)?,
                 }
             }
         })
@@ -247,6 +285,20 @@ pub struct Source {
     pub emitter: Emitter,
     /// Medium the source emits into.
     pub medium: MediumId,
+    /// What returning light meets (`None`: the lamp is transparent).
+    pub body: Option<LampBody>,
+}
+
+/// A photon leaving a source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// Where it starts (on the emitting surface) and where it goes.
+    pub ray: Ray,
+    /// The emitting surface's unit outward normal there: emitted photons start a spawn
+    /// offset off it, as scattered ones do, so they never meet their own lamp.
+    pub normal: DVec3,
+    /// The medium it starts in.
+    pub medium: MediumId,
 }
 
 impl Source {
@@ -259,8 +311,8 @@ impl Source {
         }
     }
 
-    /// A photon ray leaving this source.
-    pub fn emit(&self, rng: &mut PhotonRng) -> Ray {
+    /// A photon leaving this source: its ray and the emitting surface's normal.
+    pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3) {
         match &self.emitter {
             Emitter::Ccfl {
                 center,
@@ -274,7 +326,10 @@ impl Source {
                 let n = t * phi.cos() + b * phi.sin();
                 let along = (rng.uniform() - 0.5) * length;
                 let p = *center + *axis * along + n * *radius;
-                Ray::new(p, sampling::lambertian(n, rng.uniform(), rng.uniform()))
+                (
+                    Ray::new(p, sampling::lambertian(n, rng.uniform(), rng.uniform())),
+                    n,
+                )
             }
             Emitter::Led {
                 center,
@@ -286,7 +341,7 @@ impl Source {
             } => {
                 let p = rectangle_point(*center, *normal, *u, (*width, *height), rng);
                 let d = sampling::cos_power(*normal, *cos_exponent, rng.uniform(), rng.uniform());
-                Ray::new(p, d)
+                (Ray::new(p, d), *normal)
             }
             Emitter::MeasuredLed {
                 center,
@@ -299,7 +354,94 @@ impl Source {
                 let p = rectangle_point(*center, *normal, *u, (*width, *height), rng);
                 let theta = profile.sample_theta(rng.uniform());
                 let d = sampling::around(*normal, theta.cos(), TAU * rng.uniform());
-                Ray::new(p, d)
+                (Ray::new(p, d), *normal)
+            }
+        }
+    }
+}
+
+impl Emitter {
+    /// A deterministic grid of `n x n` points on the emitting surface, each with the
+    /// surface's unit outward normal there (for placement checks, not for tracing).
+    pub fn surface_grid(&self, n: usize) -> Vec<(DVec3, DVec3)> {
+        let f = |k: usize| (k as f64 + 0.5) / n as f64 - 0.5;
+        let mut out = Vec::with_capacity(n * n);
+        for i in 0..n {
+            for j in 0..n {
+                out.push(match self {
+                    Emitter::Ccfl {
+                        center,
+                        axis,
+                        radius,
+                        length,
+                    } => {
+                        let (t, b) = orthonormal_basis(*axis);
+                        let phi = TAU * (f(i) + 0.5);
+                        let normal = t * phi.cos() + b * phi.sin();
+                        (*center + *axis * (f(j) * length) + normal * *radius, normal)
+                    }
+                    Emitter::Led {
+                        center,
+                        normal,
+                        u,
+                        width,
+                        height,
+                        ..
+                    }
+                    | Emitter::MeasuredLed {
+                        center,
+                        normal,
+                        u,
+                        width,
+                        height,
+                        ..
+                    } => {
+                        let v = normal.cross(*u);
+                        (*center + *u * (f(i) * width) + v * (f(j) * height), *normal)
+                    }
+                });
+            }
+        }
+        out
+    }
+
+    /// The distance (mm) from `p` to the emitting surface (the tube's side, or the
+    /// rectangle).
+    pub fn surface_distance(&self, p: DVec3) -> f64 {
+        match self {
+            Emitter::Ccfl {
+                center,
+                axis,
+                radius,
+                length,
+            } => {
+                let rel = p - *center;
+                let along = rel.dot(*axis);
+                let radial = (rel - *axis * along).length() - radius;
+                let beyond = (along.abs() - 0.5 * length).max(0.0);
+                radial.hypot(beyond)
+            }
+            Emitter::Led {
+                center,
+                normal,
+                u,
+                width,
+                height,
+                ..
+            }
+            | Emitter::MeasuredLed {
+                center,
+                normal,
+                u,
+                width,
+                height,
+                ..
+            } => {
+                let rel = p - *center;
+                let v = normal.cross(*u);
+                let du = (rel.dot(*u).abs() - 0.5 * width).max(0.0);
+                let dv = (rel.dot(v).abs() - 0.5 * height).max(0.0);
+                rel.dot(*normal).hypot(du.hypot(dv))
             }
         }
     }
@@ -356,6 +498,14 @@ impl Sources {
             .enumerate()
             .map(|(i, s)| s.build(ctx, i, media))
             .collect::<Result<Vec<_>>>()?;
+        for (i, s) in list.iter().enumerate() {
+            if let Some(j) = list[..i].iter().position(|o| o.name == s.name) {
+                return Err(ctx.err(
+                    &format!("sources[{i}].name"),
+                    format!("'{}' is already the name of sources[{j}]; names must be unique (the ledger books each lamp body's absorption by name)", s.name),
+                ));
+            }
+        }
         let total: f64 = list.iter().map(|s| s.power_w).sum();
         if total > MAX_TOTAL_POWER_W {
             return Err(ctx.err(
@@ -366,13 +516,16 @@ impl Sources {
         Ok(Self::new(list))
     }
 
-    /// Move every source by `d`.
+    /// Move every source (and its body) by `d`.
     pub fn translate(&mut self, d: DVec3) {
         for s in &mut self.list {
             match &mut s.emitter {
                 Emitter::Ccfl { center, .. }
                 | Emitter::Led { center, .. }
                 | Emitter::MeasuredLed { center, .. } => *center += d,
+            }
+            if let Some(b) = &mut s.body {
+                b.shape.translate(d);
             }
         }
     }
@@ -389,14 +542,27 @@ impl Sources {
     }
 
     /// Pick a source in proportion to power and emit a photon from it.
-    pub fn sample(&self, rng: &mut PhotonRng) -> (Ray, MediumId) {
+    pub fn sample(&self, rng: &mut PhotonRng) -> Emission {
         let u = rng.uniform();
         let i = self
             .cdf
             .partition_point(|&c| c <= u)
             .min(self.list.len() - 1);
         let s = &self.list[i];
-        (s.emit(rng), s.medium)
+        let (ray, normal) = s.emit(rng);
+        Emission {
+            ray,
+            normal,
+            medium: s.medium,
+        }
+    }
+
+    /// The sources with an opaque body, by index.
+    pub fn bodies(&self) -> impl Iterator<Item = (usize, &Source, &LampBody)> {
+        self.list
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.body.as_ref().map(|b| (i, s, b)))
     }
 }
 
@@ -417,15 +583,17 @@ mod tests {
                 length: 10.0,
             },
             medium: 0,
+            body: None,
         };
         for i in 0..1000 {
             let mut rng = PhotonRng::new(3, i);
-            let r = s.emit(&mut rng);
+            let (r, n) = s.emit(&mut rng);
             let rel = r.origin - DVec3::new(1.0, 2.0, 3.0);
             let radial = DVec3::new(rel.x, 0.0, rel.z);
             assert!((radial.length() - 1.5).abs() < 1e-12);
             assert!(rel.y.abs() <= 5.0);
             assert!(r.dir.dot(radial) > 0.0);
+            assert!((n - radial / 1.5).length() < 1e-12);
         }
     }
 
@@ -444,6 +612,7 @@ mod tests {
                 cos_exponent: 1.0,
             },
             medium: 0,
+            body: None,
         };
         let s = Sources::new(vec![led(1.0), led(3.0)]);
         assert_eq!(s.cdf, vec![0.25, 1.0]);

@@ -216,6 +216,8 @@ pub enum Fate {
     AbsorbedBySurface(u32),
     /// Absorbed inside this medium (Beer-Lambert).
     AbsorbedInMedium(MediumId),
+    /// Absorbed by the body of the source with this index.
+    AbsorbedBySource(u32),
     /// Left the scene.
     Escaped,
     /// Stopped by the bounce cap.
@@ -241,6 +243,9 @@ pub struct Ledger {
     pub absorbed_by_surface: Vec<ExactSum>,
     /// Weight absorbed per medium.
     pub absorbed_in_medium: Vec<ExactSum>,
+    /// Weight absorbed per source, by its lamp body.
+    #[serde(default)]
+    pub absorbed_by_source: Vec<ExactSum>,
     /// Weight that left the scene.
     pub escaped: ExactSum,
     /// Weight stopped by the bounce cap.
@@ -252,10 +257,11 @@ pub struct Ledger {
 }
 
 impl Ledger {
-    pub(crate) fn new(tags: usize, media: usize) -> Self {
+    pub(crate) fn new(tags: usize, media: usize, sources: usize) -> Self {
         Self {
             absorbed_by_surface: vec![ExactSum::default(); tags],
             absorbed_in_medium: vec![ExactSum::default(); media],
+            absorbed_by_source: vec![ExactSum::default(); sources],
             ..Default::default()
         }
     }
@@ -265,6 +271,7 @@ impl Ledger {
             Fate::Detected => self.detected.add(w),
             Fate::AbsorbedBySurface(t) => self.absorbed_by_surface[t as usize].add(w),
             Fate::AbsorbedInMedium(m) => self.absorbed_in_medium[m as usize].add(w),
+            Fate::AbsorbedBySource(i) => self.absorbed_by_source[i as usize].add(w),
             Fate::Escaped => self.escaped.add(w),
             Fate::Killed => {
                 self.killed.add(w);
@@ -293,6 +300,7 @@ impl Ledger {
         for (mine, theirs) in [
             (&mut self.absorbed_by_surface, &o.absorbed_by_surface),
             (&mut self.absorbed_in_medium, &o.absorbed_in_medium),
+            (&mut self.absorbed_by_source, &o.absorbed_by_source),
         ] {
             for (a, b) in mine.iter_mut().zip(theirs) {
                 a.merge_signed(*b, sign);
@@ -312,6 +320,7 @@ impl Ledger {
             .absorbed_by_surface
             .iter()
             .chain(&self.absorbed_in_medium)
+            .chain(&self.absorbed_by_source)
         {
             s.merge(*a);
         }
@@ -337,7 +346,11 @@ impl Tally {
         Self {
             flux: Grid::new(d.bins[0], d.bins[1]),
             angular: Grid::new(d.angular_bins[0], d.angular_bins[1]),
-            ledger: Ledger::new(scene.tags.len(), scene.media.len()),
+            ledger: Ledger::new(
+                scene.tags.len(),
+                scene.media.len(),
+                scene.sources.list.len(),
+            ),
         }
     }
 

@@ -16,10 +16,10 @@
 
 use crate::accel::Accel;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
-use crate::optics::surface::{Estimator, MediumId, Outcome};
+use crate::optics::surface::{Estimator, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
-use crate::tally::{ChunkTally, Detection, Fate, Ledger};
+use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -58,10 +58,10 @@ impl Tracer<'_> {
     /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
     fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
-        let (ray, medium) = self.scene.sources.sample(&mut rng);
+        let e = self.scene.sources.sample(&mut rng);
         let mut p = Photon {
-            ray: SpawnedRay::unnudged(ray),
-            medium,
+            ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
+            medium: e.medium,
             weight: 1.0,
         };
         out.ledger.photons += 1;
@@ -76,7 +76,7 @@ impl Tracer<'_> {
         for _ in 0..scene.max_bounces {
             let true_ray = p.ray.true_ray();
             let surf = self.nearest_surface(p, &true_ray);
-            let t_surface = surf.map_or(f64::INFINITY, |h| h.t);
+            let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
             let detected = scene.detector.intersect(&true_ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
             if !self.cross_medium(p, t_next, rng, &mut out.ledger) {
@@ -87,12 +87,11 @@ impl Tracer<'_> {
                     .push(detection(scene, ab, true_ray.dir, p.weight));
                 return Fate::Detected;
             }
-            let Some(surf) = surf else {
+            let Some(Hit { surf, struck }) = surf else {
                 return Fate::Escaped;
             };
             out.ledger.interactions += 1;
-            let tag = scene.mesh.tri_tag[surf.prim as usize];
-            let model = &scene.surfaces[tag as usize];
+            let model = self.model(struck);
             match model.interact(
                 &scene.media,
                 &surf,
@@ -101,18 +100,14 @@ impl Tracer<'_> {
                 self.estimator,
                 rng,
             ) {
-                Outcome::Absorbed => return Fate::AbsorbedBySurface(tag),
+                Outcome::Absorbed => return struck.absorbed(),
                 Outcome::Scattered {
                     dir,
                     medium,
                     weight,
                 } => {
                     let w = p.weight * weight;
-                    Ledger::lose(
-                        &mut out.ledger.absorbed_by_surface[tag as usize],
-                        p.weight,
-                        w,
-                    );
+                    Ledger::lose(struck.sink(&mut out.ledger), p.weight, w);
                     p.weight = w;
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
@@ -125,8 +120,19 @@ impl Tracer<'_> {
         Fate::Killed
     }
 
-    /// The surface `p` reaches first along `true_ray` (its path from its true position).
-    fn nearest_surface(&self, p: &Photon, true_ray: &Ray) -> Option<SurfaceHit> {
+    /// The surface or lamp body `p` reaches first along `true_ray` (its path from its
+    /// true position).
+    fn nearest_surface(&self, p: &Photon, true_ray: &Ray) -> Option<Hit> {
+        let mesh = self.nearest_triangle(p, true_ray).map(|surf| Hit {
+            struck: Struck::Surface(self.scene.mesh.tri_tag[surf.prim as usize]),
+            surf,
+        });
+        let t_mesh = mesh.map_or(f64::INFINITY, |h| h.surf.t);
+        self.nearest_body(p, t_mesh).or(mesh)
+    }
+
+    /// The triangle `p` reaches first along `true_ray`.
+    fn nearest_triangle(&self, p: &Photon, true_ray: &Ray) -> Option<SurfaceHit> {
         let scene = self.scene;
         match scene.convex_solid(p.medium).filter(|_| self.convex) {
             // The convex path needs no nudge: it finds the exit from the true position.
@@ -138,6 +144,51 @@ impl Tracer<'_> {
                 let n = self.normals[h.prim as usize];
                 p.ray.refine_hit(&scene.mesh, h.prim, h.t, n)
             }),
+        }
+    }
+
+    /// The nearest lamp body in `p`'s medium that `p` meets before distance `t_max`.
+    /// Bodies are intersected exactly along the search ray (which starts a spawn offset
+    /// off the surface `p` left, so a photon leaving a body never meets it again at
+    /// distance ~0); distances are measured from the true position, as for triangles.
+    fn nearest_body(&self, p: &Photon, t_max: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        for (i, source, body) in self.scene.sources.bodies() {
+            if source.medium != p.medium {
+                continue;
+            }
+            let Some(h) = body.hit(&p.ray.search, f64::INFINITY) else {
+                continue;
+            };
+            let point = p.ray.search.at(h.t);
+            let t = (point - p.ray.from).length();
+            if t < best.map_or(t_max, |b| b.surf.t) {
+                let surf = SurfaceHit {
+                    t,
+                    prim: NO_TRIANGLE,
+                    point,
+                    normal: h.normal,
+                };
+                let struck = if h.front {
+                    Struck::Body(i as u32)
+                } else {
+                    Struck::BodyBack(i as u32)
+                };
+                best = Some(Hit { surf, struck });
+            }
+        }
+        best
+    }
+
+    /// The surface model a photon meets.
+    fn model(&self, struck: Struck) -> &SurfaceModel {
+        match struck {
+            Struck::Surface(tag) => &self.scene.surfaces[tag as usize],
+            Struck::Body(i) => {
+                let body = self.scene.sources.list[i as usize].body.as_ref();
+                &body.expect("only bodies are struck").model
+            }
+            Struck::BodyBack(_) => &SurfaceModel::Absorber,
         }
     }
 
@@ -181,7 +232,11 @@ impl Tracer<'_> {
         let mut out = ChunkTally {
             index,
             detections: Vec::new(),
-            ledger: Ledger::new(self.scene.tags.len(), self.scene.media.len()),
+            ledger: Ledger::new(
+                self.scene.tags.len(),
+                self.scene.media.len(),
+                self.scene.sources.list.len(),
+            ),
         };
         for i in lo..hi {
             self.trace_photon(seed, i, &mut out);
@@ -215,6 +270,45 @@ impl Tracer<'_> {
             done.iter().for_each(&mut *sink);
         }
     }
+}
+
+/// The `prim` of a hit on a lamp body, which is no triangle of the mesh.
+const NO_TRIANGLE: u32 = u32::MAX;
+
+/// What a photon's segment ends on.
+#[derive(Clone, Copy, Debug)]
+enum Struck {
+    /// A triangle with this tag.
+    Surface(u32),
+    /// The body of the source with this index.
+    Body(u32),
+    /// The absorbing back of an LED's one-sided body.
+    BodyBack(u32),
+}
+
+impl Struck {
+    /// The fate of a photon absorbed there.
+    fn absorbed(self) -> Fate {
+        match self {
+            Struck::Surface(tag) => Fate::AbsorbedBySurface(tag),
+            Struck::Body(i) | Struck::BodyBack(i) => Fate::AbsorbedBySource(i),
+        }
+    }
+
+    /// The ledger entry that books what is absorbed there.
+    fn sink(self, ledger: &mut Ledger) -> &mut ExactSum {
+        match self {
+            Struck::Surface(tag) => &mut ledger.absorbed_by_surface[tag as usize],
+            Struck::Body(i) | Struck::BodyBack(i) => &mut ledger.absorbed_by_source[i as usize],
+        }
+    }
+}
+
+/// A hit and what was struck.
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    surf: SurfaceHit,
+    struck: Struck,
 }
 
 /// Russian roulette on low weights (weighted estimator only): false when the photon dies.

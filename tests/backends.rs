@@ -707,7 +707,11 @@ fn scene_queries(scene: &Scene, photons: u64, bounces: usize, seed: u64) -> Vec<
         .into_par_iter()
         .flat_map_iter(|i| {
             let mut rng = PhotonRng::new(seed, i);
-            let (mut ray, _medium) = scene.sources.sample(&mut rng);
+            let e = scene.sources.sample(&mut rng);
+            let mut ray = Ray::new(
+                scene.spawn_point(e.ray.origin, e.normal, e.ray.dir),
+                e.ray.dir,
+            );
             let mut out = Vec::new();
             for _ in 0..=bounces {
                 out.push((ray, f64::INFINITY));

@@ -446,20 +446,20 @@ fn placement_mistakes_are_warned() {
         "{:?}",
         s.warnings
     );
-    // The same part 1000 x too large (mm read as metres).
+    // The same part 1000 x too large (mm read as metres), moved clear of the LED (which
+    // it would otherwise swallow: an error, tested below).
     let s = load_one(
         "cad-huge",
         "part.obj",
         obj(&tris).as_bytes(),
-        "units = \"m\"",
+        "units = \"m\"\ntranslate = [0.0, 0.0, 1000000.0]",
     );
     assert!(
         s.warnings.iter().any(|w| w.contains("check units")),
         "{:?}",
         s.warnings
     );
-    // Lifted by 2 mm, the part is cut by the detector plane (z = 4.5); moved 1 mm towards
-    // the LED and lifted 1 mm, its bottom face crosses the LED's emitting rectangle.
+    // Lifted by 2 mm, the part is cut by the detector plane (z = 4.5).
     let s = load_one(
         "cad-cut",
         "part.obj",
@@ -473,18 +473,21 @@ fn placement_mistakes_are_warned() {
         "{:?}",
         s.warnings
     );
-    let s = load_one(
+    // Moved 1 mm towards the LED and lifted 1 mm, the PMMA part's bottom face crosses
+    // the LED's emitting rectangle: the lamp lies half in the PMMA, half in air.
+    let dir = write_scene(
         "cad-led",
-        "part.obj",
-        obj(&tris).as_bytes(),
-        "translate = [-1.0, 0.0, 1.0]",
+        &scene_toml("file = \"part.obj\"\ntranslate = [-1.0, 0.0, 1.0]"),
+        &[],
+    );
+    std::fs::write(dir.parent().unwrap().join("part.obj"), obj(&tris)).unwrap();
+    let e = format!(
+        "{:#}",
+        Scene::load(&dir).expect_err("a lamp across a solid's face")
     );
     assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.contains("emitting surface cuts tag 'lgp'")),
-        "{:?}",
-        s.warnings
+        e.contains("sources[0].center") && e.contains("crosses the boundary"),
+        "{e}"
     );
 }
 

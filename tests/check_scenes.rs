@@ -1,5 +1,5 @@
 //! `blutrace check` on every bundled scene (found by walking `scenes/`): each one loads,
-//! validates and reports without a warning.
+//! validates and reports without a warning, and lists each source's medium and body.
 
 mod support;
 
@@ -36,5 +36,12 @@ fn check_passes_on_every_bundled_scene() {
             );
         }
         assert!(!stdout.contains("warning"), "check {p} warns: {stdout}");
+        // Every source reports its medium and its body.
+        for line in stdout.lines().filter(|l| l.starts_with("source ")) {
+            assert!(
+                line.contains(" in ") && line.contains("; body: "),
+                "check {p}: {line}"
+            );
+        }
     }
 }

@@ -446,7 +446,8 @@ fn bad_groove_and_diffuser_parameters_are_named() {
 fn diffuser_faces_spread_light_and_lose_none() {
     // A 1 mm PMMA slab with a rough top face, lit from below through its smooth bottom by
     // a collimated beam: lossless (every photon is detected above or escapes), and the
-    // light above is spread over the hemisphere instead of leaving straight up.
+    // light above is spread over the hemisphere instead of leaving straight up. The beam's
+    // source is a probe, not a lamp: it has no body.
     let obj = box_obj(
         [-50.0, -50.0, 0.0],
         [50.0, 50.0, 1.0],
@@ -459,7 +460,7 @@ fn diffuser_faces_spread_light_and_lose_none() {
              [surfaces.bottom]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
              [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
              [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\nu = [1.0, 0.0, 0.0]\n\
-             width_mm = 0.1\nheight_mm = 0.1\npower_w = 1.0\ncos_exponent = 1e6\n\
+             width_mm = 0.1\nheight_mm = 0.1\npower_w = 1.0\ncos_exponent = 1e6\nbody = \"transparent\"\n\
              [detector]\norigin = [-500.0, -500.0, 1.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [1000.0, 1000.0]\n\
              bins = [2, 2]\nangular_bins = [18, 4]\n"
         );

@@ -357,6 +357,7 @@ fn measured_led_directions_follow_the_intensity_profile() {
                 profile: profile.clone(),
             },
             medium: 0,
+            body: None,
         };
         // Intensity is power per steradian: the density is I / (2 pi int I sin theta).
         let steps = 200_000;
@@ -375,7 +376,7 @@ fn measured_led_directions_follow_the_intensity_profile() {
             &grid,
             &mut |i| {
                 let mut rng = PhotonRng::new(5, i as u64);
-                Some(source.emit(&mut rng).dir)
+                Some(source.emit(&mut rng).0.dir)
             },
             &pdf,
             16,

@@ -241,3 +241,87 @@ fn bins_beyond_the_memory_budget_are_refused_before_tracing() {
     let ok = load(&write_scene("bins-ok", GOOD, &[("plate.obj", &obj)]));
     assert!(blutrace::run::check_tally_budget(&ok).unwrap() < 1 << 30);
 }
+
+#[test]
+fn lamp_body_unknown_model() {
+    let msg = error_of(
+        "body-model",
+        &GOOD.replace(
+            "power_w = 1.0",
+            "power_w = 1.0\nbody = { model = \"velvet\" }",
+        ),
+    );
+    assert_mentions(&msg, &["scene.toml", "velvet", "lambert"]);
+    let msg = error_of(
+        "body-word",
+        &GOOD.replace("power_w = 1.0", "power_w = 1.0\nbody = \"black\""),
+    );
+    assert_mentions(
+        &msg,
+        &["scene.toml", "black", "\"absorber\", \"transparent\""],
+    );
+}
+
+#[test]
+fn lamp_body_albedo_outside_zero_one() {
+    for a in ["1.2", "-0.1", "nan"] {
+        let msg = error_of(
+            "body-albedo",
+            &GOOD.replace(
+                "power_w = 1.0",
+                &format!("power_w = 1.0\nbody = {{ model = \"lambert\", albedo = {a} }}"),
+            ),
+        );
+        assert_mentions(&msg, &["scene.toml", "sources[0].body.albedo"]);
+    }
+}
+
+#[test]
+fn lamp_inside_a_solid_must_name_its_medium() {
+    // The CCFL moved into the PMMA plate (z = 0, plate 1 mm thick... tube r = 0.3 mm),
+    // its medium left as air.
+    let inside = GOOD
+        .replace("center = [-12.0, 0.0, 0.0]", "center = [0.0, 0.0, 0.0]")
+        .replace("radius_mm = 1.0", "radius_mm = 0.3")
+        .replace("length_mm = 20.0\npower_w", "length_mm = 5.0\npower_w");
+    let msg = error_of("lamp-in-pmma", &inside);
+    assert_mentions(
+        &msg,
+        &["scene.toml", "sources[0].medium", "'pmma'", "names 'air'"],
+    );
+    // Named correctly, it loads.
+    let ok = inside.replace("power_w = 1.0", "power_w = 1.0\nmedium = \"pmma\"");
+    let obj = plate();
+    load(&write_scene("lamp-in-pmma-ok", &ok, &[("plate.obj", &obj)]));
+    // In air, naming the solid's medium is refused too.
+    let msg = error_of(
+        "lamp-in-air-named-pmma",
+        &GOOD.replace("power_w = 1.0", "power_w = 1.0\nmedium = \"pmma\""),
+    );
+    assert_mentions(&msg, &["sources[0].medium", "'air'", "names 'pmma'"]);
+    // Half in, half out: the surface crosses the boundary.
+    let msg = error_of(
+        "lamp-across",
+        &GOOD.replace("center = [-12.0, 0.0, 0.0]", "center = [-10.0, 0.0, 0.3]"),
+    );
+    assert_mentions(&msg, &["sources[0].center", "crosses the boundary"]);
+}
+
+#[test]
+fn led_package_depth_and_duplicate_names() {
+    let led = "[[sources]]\ntype = \"led\"\nname = \"a\"\ncenter = [-11.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\n\
+               u = [0.0, 1.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 0.5\npower_w = 1.0\npackage_depth_mm = -1.0\n";
+    let msg = error_of(
+        "pkg-depth",
+        &GOOD.replace("[detector]", &format!("{led}[detector]")),
+    );
+    assert_mentions(&msg, &["sources[1].package_depth_mm", "> 0"]);
+    let two = GOOD.replace("power_w = 1.0", "power_w = 1.0\nname = \"lamp\"");
+    let dup = two.replace(
+        "[detector]",
+        "[[sources]]\ntype = \"ccfl\"\nname = \"lamp\"\ncenter = [12.0, 0.0, 0.0]\naxis = [0.0, 1.0, 0.0]\n\
+         radius_mm = 1.0\nlength_mm = 20.0\npower_w = 1.0\n[detector]",
+    );
+    let msg = error_of("dup-names", &dup);
+    assert_mentions(&msg, &["sources[1].name", "'lamp'", "sources[0]"]);
+}

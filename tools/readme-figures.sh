@@ -3,7 +3,7 @@
 # and the bench table. Results are deterministic (fixed seeds); only the timings depend on
 # the machine and its load, so run it on a quiet machine.
 #
-#   bash tools/readme-figures.sh [gallery|optimize|bench|all]   (default: all)
+#   bash tools/readme-figures.sh [gallery|optimize|bench|bodies|all]   (default: all)
 #
 # Logs go to out/figures/*.log; the README tables are filled in from them by hand.
 set -euo pipefail
@@ -46,6 +46,31 @@ optimize() {
   cp "$out/phone-2d/final/flux.png" docs/img/phone-led-2d-final.png
 }
 
+# notebook14's efficiency for each lamp body (README "Lamp bodies"): the scene copied with
+# every source's body replaced.
+bodies() {
+  local dir=$out/bodies
+  echo "body | extraction efficiency | absorbed by the four tubes (W of 4)" >"$out/bodies.log"
+  for body in '"transparent"' '"absorber"' '{ model = "lambert", albedo = 0.3 }' \
+    '{ model = "lambert", albedo = 0.5 }' '{ model = "lambert", albedo = 0.9 }'; do
+    rm -rf "$dir" && mkdir -p "$dir" && cp scenes/notebook14/* "$dir/"
+    BODY="$body" python3 - "$dir/scene.toml" <<'PY'
+import os, re, sys
+p = sys.argv[1]
+s = open(p).read()
+s = re.sub(r"^body = .*$", "body = " + os.environ["BODY"], s, flags=re.M)
+open(p, "w").write(s)
+PY
+    "$bin" trace "$dir" --photons 1000000 --estimator weighted --quiet --out "$dir/out" >/dev/null
+    python3 - "$dir/out/summary.json" "$body" >>"$out/bodies.log" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+l = d["ledger"]
+print(f"{sys.argv[2]} | {d['extraction_efficiency']:.4f} +- {d['extraction_efficiency_stderr']:.4f} | {sum(l['absorbed_by_source_w'].values()):.3f}")
+PY
+  done
+}
+
 bench() {
   "$bin" bench --photons 200000 >"$out/bench.log" 2>&1
 }
@@ -54,6 +79,7 @@ case "$what" in
   gallery) gallery ;;
   optimize) optimize ;;
   bench) bench ;;
-  all) gallery; optimize; bench ;;
-  *) echo "usage: $0 [gallery|optimize|bench|all]" >&2; exit 2 ;;
+  bodies) bodies ;;
+  all) gallery; bodies; optimize; bench ;;
+  *) echo "usage: $0 [gallery|optimize|bench|bodies|all]" >&2; exit 2 ;;
 esac

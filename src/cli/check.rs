@@ -32,6 +32,12 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             "scene_file": path.display().to_string(),
             "geometry": scene.geometry,
             "tally_bytes": tally_bytes,
+            "sources": scene.sources.list.iter().map(|s| serde_json::json!({
+                "name": s.name,
+                "power_w": s.power_w,
+                "medium": scene.media[s.medium as usize].name,
+                "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
+            })).collect::<Vec<_>>(),
             "warnings": scene.warnings,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -80,7 +86,15 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     let backend = crate::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
     println!("backend    auto picks {}", backend.name());
     for s in &scene.sources.list {
-        println!("source     {:<20} {:.3} W", s.name, s.power_w);
+        let body = s
+            .body
+            .as_ref()
+            .map_or("transparent (no body)".to_string(), |b| b.describe());
+        let medium = &scene.media[s.medium as usize].name;
+        println!(
+            "source     {:<20} {:.3} W in {medium}; body: {body}",
+            s.name, s.power_w
+        );
     }
     let d = &scene.detector;
     println!(

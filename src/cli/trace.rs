@@ -128,6 +128,7 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     let (u, e) = (&s.uniformity, &s.uniformity_stderr);
     let absorbed =
         l.absorbed_w.values().sum::<f64>() + l.absorbed_in_medium_w.values().sum::<f64>();
+    let lamps = l.absorbed_by_source_w.values().sum::<f64>();
     println!("scene      {} ({})", s.scene, s.scene_file);
     println!(
         "traced     {} photons, seed {}, backend {}, estimator {:?}, {} threads; stopped by {:?}",
@@ -138,10 +139,11 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         s.runtime_s, s.photons_per_s, s.interactions_per_s
     );
     println!(
-        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
+        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + lamp bodies {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
         l.emitted_w,
         l.detected_w,
         absorbed,
+        lamps,
         l.escaped_w,
         l.killed_w,
         l.roulette_w,

@@ -24,9 +24,9 @@ pub struct LambertSpec {
 }
 
 impl LambertSpec {
-    /// Check `[surfaces.TAG]`: its albedo.
-    pub fn build(&self, ctx: &Ctx, tag: &str) -> Result<f64> {
-        ctx.fraction(&format!("surfaces.{tag}.albedo"), self.albedo)
+    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`): its albedo.
+    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<f64> {
+        ctx.fraction(&format!("{at}.albedo"), self.albedo)
     }
 }
 

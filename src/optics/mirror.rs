@@ -26,9 +26,10 @@ fn one() -> f64 {
 }
 
 impl MirrorSpec {
-    /// Check `[surfaces.TAG]`: its reflectance.
-    pub fn build(&self, ctx: &Ctx, tag: &str) -> Result<f64> {
-        ctx.fraction(&format!("surfaces.{tag}.reflectance"), self.reflectance)
+    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`): its
+    /// reflectance.
+    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<f64> {
+        ctx.fraction(&format!("{at}.reflectance"), self.reflectance)
     }
 }
 

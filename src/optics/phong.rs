@@ -42,9 +42,10 @@ pub struct Phong {
 }
 
 impl PhongSpec {
-    /// Check `[surfaces.TAG]` and build its model.
-    pub fn build(&self, ctx: &Ctx, tag: &str) -> Result<Phong> {
-        let f = |k: &str| format!("surfaces.{tag}.{k}");
+    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`) and build
+    /// its model.
+    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<Phong> {
+        let f = |k: &str| format!("{at}.{k}");
         Ok(Phong {
             reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?,
             specular: ctx.fraction(&f("specular"), self.specular)?,

@@ -119,6 +119,8 @@ pub struct LedgerSummary {
     pub absorbed_w: BTreeMap<String, f64>,
     /// Power absorbed per medium (Beer-Lambert).
     pub absorbed_in_medium_w: BTreeMap<String, f64>,
+    /// Power absorbed per source by its lamp body (0 for transparent bodies).
+    pub absorbed_by_source_w: BTreeMap<String, f64>,
     /// Power that left the scene.
     pub escaped_w: f64,
     /// Power stopped by the bounce cap.
@@ -163,6 +165,13 @@ impl RunResult<'_> {
                 .collect()
         };
         let media: Vec<String> = self.scene.media.iter().map(|m| m.name.clone()).collect();
+        let sources: Vec<String> = self
+            .scene
+            .sources
+            .list
+            .iter()
+            .map(|s| s.name.clone())
+            .collect();
         let (eff, eff_se) = l.detected.mean_and_stderr(l.photons);
         let d = &self.scene.detector;
         let target = self.options.target_metric;
@@ -191,6 +200,7 @@ impl RunResult<'_> {
                 detected_w: l.detected.sum.value() * w,
                 absorbed_w: named(&self.scene.tags, &l.absorbed_by_surface),
                 absorbed_in_medium_w: named(&media, &l.absorbed_in_medium),
+                absorbed_by_source_w: named(&sources, &l.absorbed_by_source),
                 escaped_w: l.escaped.value() * w,
                 killed_w: l.killed.value() * w,
                 killed_photons: l.killed_photons,

@@ -158,11 +158,15 @@ pub fn source_cuts(
 ) -> Vec<String> {
     let mut out = Vec::new();
     for s in sources {
+        let grid = s.emitter.surface_grid(24);
         let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
         for (p, &tag) in mesh.tri_tag.iter().enumerate() {
             let c = mesh.corners(p as u32);
-            if cuts_emitter(&s.emitter, c, eps) {
-                hit.entry(tag).or_insert(c[0] + offset);
+            if hit.contains_key(&tag) {
+                continue;
+            }
+            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {
+                hit.insert(tag, c[0] + offset);
             }
         }
         out.extend(hit.into_iter().map(|(tag, at)| {
@@ -173,6 +177,26 @@ pub fn source_cuts(
         }));
     }
     out
+}
+
+/// True when points of the emitting surface's `grid` lie more than `eps` on both sides of
+/// triangle `prim`, with their feet inside it: the triangle passes through the surface
+/// (a sheet through a tube, whose vertices all lie outside it).
+fn crosses_grid(mesh: &Mesh, prim: u32, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
+    let c = mesh.corners(prim);
+    let n = mesh.area_normal(prim).normalize_or_zero();
+    let (mut above, mut below) = (false, false);
+    for &(g, _) in grid {
+        let h = n.dot(g - c[0]);
+        if h.abs() > eps && mesh.contains(prim, g - n * h) {
+            above |= h > 0.0;
+            below |= h < 0.0;
+            if above && below {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {

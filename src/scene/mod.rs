@@ -12,6 +12,7 @@ pub mod config;
 pub mod geometry_file;
 pub mod geometry_report;
 mod hash;
+mod lamp_placement;
 pub mod meshio;
 mod solids;
 
@@ -116,6 +117,13 @@ impl Scene {
         ));
         fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
         let sources = Sources::build(&ctx, &file.sources, &media)?;
+        lamp_placement::check_source_media(
+            &ctx,
+            &mesh,
+            &|p| surfaces[mesh.tri_tag[p] as usize].interface(),
+            &media,
+            &sources.list,
+        )?;
         let detector = build_detector(&ctx, &file.detector)?;
         if file.trace.max_bounces == 0 {
             return Err(ctx.err("trace.max_bounces", "must be at least 1"));
@@ -251,6 +259,13 @@ fn placement_warnings(scene: &Scene) -> Vec<String> {
         tags,
         &scene.sources.list,
         eps,
+        scene.offset,
+    ));
+    w.extend(lamp_placement::contact_warnings(
+        mesh,
+        tags,
+        &scene.sources.list,
+        2.0 * eps,
         scene.offset,
     ));
     w
@@ -409,12 +424,12 @@ fn build_surface(
                 roughness,
             }
         }
-        SurfaceSpec::Phong(s) => SurfaceModel::Phong(s.build(ctx, tag)?),
+        SurfaceSpec::Phong(s) => SurfaceModel::Phong(s.build(ctx, &format!("surfaces.{tag}"))?),
         SurfaceSpec::Lambert(s) => SurfaceModel::Lambert {
-            albedo: s.build(ctx, tag)?,
+            albedo: s.build(ctx, &format!("surfaces.{tag}"))?,
         },
         SurfaceSpec::Mirror(s) => SurfaceModel::Mirror {
-            reflectance: s.build(ctx, tag)?,
+            reflectance: s.build(ctx, &format!("surfaces.{tag}"))?,
         },
         SurfaceSpec::Absorber(_) => SurfaceModel::Absorber,
     })

@@ -207,14 +207,9 @@ pub(super) fn overlap_warnings(
     surfaces_by_tri: impl Fn(usize) -> Option<crate::optics::medium::Interface>,
     media: &[Medium],
 ) -> Vec<String> {
-    let solid = |m: usize| -> Vec<usize> {
-        (0..mesh.len())
-            .filter(|&p| surfaces_by_tri(p).is_some_and(|i| i.inside as usize == m))
-            .collect()
-    };
-    let solids: Vec<(usize, Vec<usize>)> = (1..media.len())
-        .map(|m| (m, solid(m)))
-        .filter(|(_, t)| !t.is_empty())
+    let solids: Vec<(usize, Vec<usize>)> = closed_solids(mesh, &surfaces_by_tri, media.len())
+        .into_iter()
+        .map(|s| (s.medium, s.tris))
         .collect();
     let mut out = Vec::new();
     for (m, tris) in &solids {
@@ -243,6 +238,54 @@ pub(super) fn overlap_warnings(
         }
     }
     out
+}
+
+/// The closed solid of one medium: the faces that name it inside (oriented outward).
+pub(super) struct Solid {
+    /// The medium inside.
+    pub medium: usize,
+    /// Its triangles.
+    pub tris: Vec<usize>,
+    /// Its enclosed volume (mm^3).
+    pub volume: f64,
+}
+
+/// The closed solid of every medium but air that some face names inside.
+pub(super) fn closed_solids(
+    mesh: &Mesh,
+    interface_of: &dyn Fn(usize) -> Option<crate::optics::medium::Interface>,
+    media: usize,
+) -> Vec<Solid> {
+    let mut tris = vec![Vec::new(); media];
+    for p in 0..mesh.len() {
+        if let Some(i) = interface_of(p) {
+            tris[i.inside as usize].push(p);
+        }
+    }
+    tris.into_iter()
+        .enumerate()
+        .skip(1)
+        .filter(|(_, t)| !t.is_empty())
+        .map(|(medium, tris)| Solid {
+            medium,
+            volume: tris
+                .iter()
+                .map(|&p| signed_volume(mesh, p))
+                .sum::<f64>()
+                .abs(),
+            tris,
+        })
+        .collect()
+}
+
+/// The medium at `p`: the smallest closed solid around it (winding number above 1/2),
+/// air (0) outside them all.
+pub(super) fn medium_at(mesh: &Mesh, solids: &[Solid], p: glam::DVec3) -> usize {
+    solids
+        .iter()
+        .filter(|s| winding(mesh, &s.tris, p) > 0.5)
+        .min_by(|a, b| a.volume.total_cmp(&b.volume))
+        .map_or(0, |s| s.medium)
 }
 
 /// Vertices tested per solid for overlaps.

@@ -6,8 +6,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num,
+    tags_of, write_mtl, write_obj,
 };
 
 /// Light guide size (x, y, z) (mm); it spans 0..GUIDE, lit through its x = 0 edge.
@@ -270,7 +270,7 @@ u = [0.0, 1.0, 0.0]
 width_mm = {lw}
 height_mm = {lh}
 power_w = 1.0
-
+{LED_BODY}
 [detector]
 origin = {o}
 u = [1.0, 0.0, 0.0]

@@ -20,8 +20,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
+    tags_of, write_mtl, write_obj,
 };
 
 /// Files below `scenes/` written by `tools/cad/export-reflector.sh`, not by scenegen.
@@ -208,7 +208,7 @@ axis = [0.0, 1.0, 0.0]
 radius_mm = {r}
 length_mm = {w}
 power_w = 1.0
-
+{CCFL_BODY}
 [detector]
 origin = {o}
 u = [1.0, 0.0, 0.0]

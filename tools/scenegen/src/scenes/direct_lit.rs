@@ -14,8 +14,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
+    tags_of, write_mtl, write_obj,
 };
 
 /// Inner box length along x, across the lamps (mm).
@@ -345,7 +345,7 @@ axis = [0.0, 1.0, 0.0]
 radius_mm = {}
 length_mm = {}
 power_w = {}
-",
+{CCFL_BODY}",
                 i + 1,
                 arr(c),
                 num(LAMP_R),

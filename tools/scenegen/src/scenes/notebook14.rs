@@ -3,8 +3,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, LampHolder, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+    CCFL_BODY, GenFile, LampHolder, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron,
+    num, tags_of, write_mtl, write_obj,
 };
 
 /// Light guide length along x, lamp edge to lamp edge (mm).
@@ -213,7 +213,7 @@ radius_mm = {}
 length_mm = {}
 power_w = 1.0
 lumens = 300.0
-",
+{CCFL_BODY}",
             arr(&c),
             num(LAMP_R),
             num(W)

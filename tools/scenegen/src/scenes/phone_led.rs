@@ -8,7 +8,7 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
+    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
     write_mtl, write_obj,
 };
 
@@ -343,7 +343,7 @@ height_mm = {}
 power_w = {}
 lumens = {:.2}
 intensity_file = \"led.ies\"
-",
+{LED_BODY}",
             i + 1,
             arr(c),
             num(LED_W),

@@ -2,7 +2,9 @@
 //! (`.gltf` JSON plus a `.bin` buffer) under a translated root node.
 
 use super::{GENERATED, trace_table};
-use crate::{GenFile, LampHolder, P3, Part, arr, comment, dim, dims, hexahedron, num, write_gltf};
+use crate::{
+    CCFL_BODY, GenFile, LampHolder, P3, Part, arr, comment, dim, dims, hexahedron, num, write_gltf,
+};
 
 /// Light guide length along x, lamp edge to far edge (mm).
 pub const L: f64 = 200.0;
@@ -210,7 +212,7 @@ axis = [0.0, 1.0, 0.0]
 radius_mm = {lr}
 length_mm = {lw}
 power_w = 1.0
-
+{CCFL_BODY}
 [detector]
 origin = {d}
 u = [1.0, 0.0, 0.0]

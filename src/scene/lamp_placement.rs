@@ -1,0 +1,160 @@
+//! Where each lamp sits relative to the geometry: in which medium its emitting surface
+//! lies, and which parts come so close to that surface that emitted photons would start
+//! beyond them.
+//!
+//! ```toml
+//! [[sources]]
+//! type = "ccfl"
+//! center = [-3.0, 100.0, 1.5]
+//! medium = "air"   # must be the medium the emitting surface really lies in
+//! ```
+//!
+//! A source inside a closed solid (a CCFL bored into the PMMA, an LED potted in
+//! silicone) must name that solid's medium, and a source in air must not name a solid's
+//! medium: otherwise its photons would be traced with the wrong refractive index and
+//! absorption until their first surface, without a word.
+
+use super::solids;
+use crate::geometry::Mesh;
+use crate::optics::medium::{Interface, Medium};
+use crate::sources::Source;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use std::collections::BTreeMap;
+
+/// Points per side of the grid on each emitting surface that is tested.
+const GRID: usize = 16;
+
+/// Check that every source names the medium its emitting surface lies in (positions in
+/// the scene file's frame, before recentring). The medium of a point is the innermost
+/// closed solid around it (winding number), air outside them all.
+pub(super) fn check_source_media(
+    ctx: &Ctx,
+    mesh: &Mesh,
+    interface_of: &dyn Fn(usize) -> Option<Interface>,
+    media: &[Medium],
+    sources: &[Source],
+) -> Result<()> {
+    let solids = solids::closed_solids(mesh, interface_of, media.len());
+    if solids.is_empty() {
+        return Ok(());
+    }
+    let hair = 1e-6 * mesh.bounds().diagonal().max(1.0);
+    for (i, s) in sources.iter().enumerate() {
+        let mut found: Option<(usize, DVec3)> = None;
+        for (p, n) in s.emitter.surface_grid(GRID) {
+            let q = p + n * hair;
+            let m = solids::medium_at(mesh, &solids, q);
+            match found {
+                None => found = Some((m, p)),
+                Some((m0, p0)) if m0 != m => {
+                    return Err(ctx.err(
+                        &format!("sources[{i}].center"),
+                        format!(
+                            "the emitting surface of '{}' crosses the boundary between media '{}' (near {}) and '{}' (near {}); a lamp must lie wholly in one medium",
+                            s.name,
+                            media[m0].name,
+                            mm(p0),
+                            media[m].name,
+                            mm(p)
+                        ),
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
+        let (m, p) = found.expect("the grid has points");
+        if m != s.medium as usize {
+            return Err(ctx.err(
+                &format!("sources[{i}].medium"),
+                format!(
+                    "the emitting surface of '{}' lies in medium '{}' (near {}), but the source names '{}'",
+                    s.name,
+                    media[m].name,
+                    mm(p),
+                    media[s.medium as usize].name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Warnings for parts whose faces come within `reach` (mm) of a lamp's emitting
+/// surface: emitted photons start a spawn offset off that surface, so such a face may be
+/// skipped by part of the emission. Positions in the scene file's frame (`offset` added).
+pub(super) fn contact_warnings(
+    mesh: &Mesh,
+    tags: &[String],
+    sources: &[Source],
+    reach: f64,
+    offset: DVec3,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in sources {
+        let grid = s.emitter.surface_grid(2 * GRID);
+        let (lo, hi) = bounds(grid.iter().map(|g| g.0), reach);
+        let mut near: BTreeMap<u32, DVec3> = BTreeMap::new();
+        for (p, &tag) in mesh.tri_tag.iter().enumerate() {
+            let c = mesh.corners(p as u32);
+            let (tlo, thi) = bounds(c.into_iter(), 0.0);
+            if near.contains_key(&tag) || (tlo.cmpgt(hi).any() || thi.cmplt(lo).any()) {
+                continue;
+            }
+            if let Some(at) = touches(mesh, p as u32, c, s, &grid, reach) {
+                near.insert(tag, at + offset);
+            }
+        }
+        out.extend(near.into_iter().map(|(tag, at)| {
+            format!(
+                "source '{}': tag '{}' lies within {reach:.1e} mm of its emitting surface (near {}); emitted photons start that far off the lamp and may skip it: move the part off the lamp, or make it the lamp's body",
+                s.name,
+                tags[tag as usize],
+                mm(at)
+            )
+        }));
+    }
+    out
+}
+
+/// A point where triangle `prim` (corners `c`) comes within `reach` of the emitting
+/// surface: a point of the triangle near the surface, or a point of the surface near
+/// the triangle.
+fn touches(
+    mesh: &Mesh,
+    prim: u32,
+    c: [DVec3; 3],
+    s: &Source,
+    grid: &[(DVec3, DVec3)],
+    reach: f64,
+) -> Option<DVec3> {
+    const STEPS: usize = 8;
+    for i in 0..=STEPS {
+        for j in 0..=STEPS - i {
+            let (a, b) = (i as f64 / STEPS as f64, j as f64 / STEPS as f64);
+            let p = c[0] + (c[1] - c[0]) * a + (c[2] - c[0]) * b;
+            if s.emitter.surface_distance(p) <= reach {
+                return Some(p);
+            }
+        }
+    }
+    let n = mesh.area_normal(prim).normalize_or_zero();
+    grid.iter().find_map(|&(g, _)| {
+        let h = n.dot(g - c[0]);
+        let foot = g - n * h;
+        (h.abs() <= reach && mesh.contains(prim, foot)).then_some(g)
+    })
+}
+
+fn bounds(points: impl Iterator<Item = DVec3>, pad: f64) -> (DVec3, DVec3) {
+    let (lo, hi) = points.fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    (lo - pad, hi + pad)
+}
+
+fn mm(p: DVec3) -> String {
+    format!("({:.3}, {:.3}, {:.3}) mm", p.x, p.y, p.z)
+}

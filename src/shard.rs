@@ -13,7 +13,7 @@
 //! `--partial` is given, which merges what is there and says what is missing.
 
 use crate::optics::surface::Estimator;
-use crate::output::atomic::StagedDir;
+use crate::output::atomic::OutputSet;
 use crate::run::{ConvergenceRow, RunOptions, RunResult, Shard, StoppedBy, metrics};
 use crate::scene::Scene;
 use crate::tally::Tally;
@@ -80,9 +80,10 @@ pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
         threads: result.threads,
         groups: result.groups.clone(),
     };
-    let mut staged = StagedDir::new(dir)?;
-    staged.write_bytes(SHARD_FILE, &serde_json::to_vec(&file)?)?;
-    Ok(staged.commit()?.remove(0))
+    let staged = OutputSet::new(dir, &[SHARD_FILE])?;
+    let path = staged.write_bytes(SHARD_FILE, &serde_json::to_vec(&file)?)?;
+    staged.commit()?;
+    Ok(path)
 }
 
 /// Read a shard file, or `dir/shard.json` when given a folder.

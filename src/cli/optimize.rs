@@ -58,6 +58,7 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
             scene.name, options.method
         ))
     });
+    crate::output::atomic::check_dest(&out, crate::optimize::OUTPUT_NAMES)?;
     let objective = if options.tunes_grid() {
         "area cv of the flux map (2-D density grid)"
     } else {

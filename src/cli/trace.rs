@@ -4,6 +4,7 @@
 use super::{default_out, scene_path};
 use crate::accel::BackendChoice;
 use crate::estimator::Estimator;
+use crate::output::atomic::check_dest;
 use crate::run::{self, RunOptions, Shard, TargetMetric};
 use crate::scene::Scene;
 use crate::shard;
@@ -94,11 +95,18 @@ pub(super) fn trace(args: TraceArgs) -> Result<()> {
         shard: args.shard,
         convex: !args.no_convex,
     };
+    let out = args.out.unwrap_or_else(|| default_out(&scene.name));
+    // A folder the run could not replace is refused before tracing, not after.
+    let names = if args.shard.is_some() {
+        &[shard::SHARD_FILE][..]
+    } else {
+        run::OUTPUT_NAMES
+    };
+    check_dest(&out, names)?;
     let (first, last) = options.photon_range();
     let bar = progress_bar(last - first, args.quiet);
     let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
-    let out = args.out.unwrap_or_else(|| default_out(&scene.name));
     if let Some(sh) = args.shard {
         let (first, last) = options.photon_range();
         let file = shard::write_shard(&result, &out)?;
@@ -237,6 +245,7 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
             list.join(", ")
         );
     }
+    check_dest(&args.out, run::OUTPUT_NAMES)?;
     let result = shard::merge(&shards, &scene)?;
     let files = result.write(&args.out)?;
     print_report(&result.summary(), &files);

@@ -3,19 +3,19 @@
 use super::OptimizeResult;
 use super::objective::Evaluation;
 use crate::optics::dots::{Density, DensityGrid};
-use crate::output::atomic::StagedDir;
+use crate::output::atomic::SetDir;
 use crate::output::plot::{Chart, Scale, Series, write_chart};
 use crate::output::png::{PreviewOptions, write_false_colour};
 use anyhow::Result;
 use std::path::Path;
 
 impl OptimizeResult {
-    /// Stage `density.png`, `profile.png` and, for a density grid, `density_map.png`.
-    pub(super) fn write_charts(&self, staged: &mut StagedDir) -> Result<()> {
-        write_chart(&staged.stage_path("density.png"), &self.density_chart())?;
-        write_chart(&staged.stage_path("profile.png"), &self.profile_chart())?;
+    /// Write `density.png`, `profile.png` and, for a density grid, `density_map.png`.
+    pub(super) fn write_charts(&self, out: &SetDir) -> Result<()> {
+        out.write_with("density.png", |p| write_chart(p, &self.density_chart()))?;
+        out.write_with("profile.png", |p| write_chart(p, &self.profile_chart()))?;
         if let Density::Grid(g) = &self.final_density {
-            write_density_map(&staged.stage_path("density_map.png"), g)?;
+            out.write_with("density_map.png", |p| write_density_map(p, g))?;
         }
         Ok(())
     }

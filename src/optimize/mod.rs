@@ -59,6 +59,7 @@ mod verify;
 mod write;
 
 pub use options::{Method, OptimizeOptions};
+pub use write::OUTPUT_NAMES;
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};
 pub use search::violation;

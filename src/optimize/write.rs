@@ -2,12 +2,27 @@
 
 use super::{OptimizeResult, export};
 use crate::optics::dots::Density;
-use crate::output::atomic::StagedDir;
+use crate::output::atomic::OutputSet;
 use crate::scene::Scene;
 use crate::scene::config::SceneFile;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// Every file and folder `blutrace optimize` writes.
+pub const OUTPUT_NAMES: &[&str] = &[
+    "optimized.toml",
+    "history.csv",
+    "density.png",
+    "profile.png",
+    "density_map.png",
+    "dots.csv",
+    "dots.svg",
+    "dots.dxf",
+    "optimize.json",
+    "initial",
+    "final",
+];
 
 impl OptimizeResult {
     /// `history.csv`: one row per iteration.
@@ -56,8 +71,9 @@ impl OptimizeResult {
         s
     }
 
-    /// Write every output into `dir`: all files are staged and moved into place only
-    /// when everything has been written; returns the files and folders written.
+    /// Write every output into `dir` as one set ([`OutputSet`]): it replaces the folder's
+    /// previous contents only when everything has been written; returns the files and
+    /// folders written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
         let toml_text = self.optimized_toml()?;
         // The optimized scene must load as it is.
@@ -66,10 +82,10 @@ impl OptimizeResult {
             .map_err(|e| anyhow::anyhow!("optimized scene does not parse: {e}"))?;
         Scene::from_file(&file, &dest).context("the optimized scene does not load")?;
 
-        let mut staged = StagedDir::new(dir)?;
+        let staged = OutputSet::new(dir, OUTPUT_NAMES)?;
         staged.write_bytes("optimized.toml", toml_text.as_bytes())?;
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
-        self.write_charts(&mut staged)?;
+        self.write_charts(&staged)?;
         let sheet = &self.sheet;
         staged.write_bytes("dots.csv", export::to_csv(&self.dots, sheet).as_bytes())?;
         staged.write_bytes("dots.svg", export::to_svg(&self.dots, sheet).as_bytes())?;
@@ -77,7 +93,7 @@ impl OptimizeResult {
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
 
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
-            run.result().write(&staged.stage_dir(name))?;
+            run.result().write_into(&staged.subdir(name)?)?;
         }
         staged.commit()
     }

@@ -1,239 +1,453 @@
-//! All-or-nothing output: stage files under temporary names, then rename them into place.
+//! All-or-nothing output sets: every file of a run is written into a hidden staging folder
+//! next to the output folder, which then replaces the previous folder in one step.
 //!
-//! A [`StagedDir`] hands out temporary paths inside the target directory (hidden names of
-//! the form `.NAME.tmp-PID-N`), so the final rename is within one file system and therefore
-//! atomic per file. [`StagedDir::commit`] fsyncs every staged file before renaming any of
-//! them; dropping a `StagedDir` without committing (an error, a panic, Ctrl-C unwinding)
-//! deletes the temporary files, so a failed run leaves neither half-written nor partial
-//! output files behind. A whole folder (written by its own `StagedDir`, say) can be staged
-//! the same way with [`StagedDir::stage_dir`].
+//! [`OutputSet::new`]`(dest)` creates `PARENT/.NAME.tmp-PID-N` beside `dest = PARENT/NAME`;
+//! writers write plain names inside it ([`SetDir::write_with`], [`SetDir::write_bytes`],
+//! subfolders through [`SetDir::subdir`]). [`OutputSet::commit`] syncs every file to disk,
+//! writes the manifest [`MANIFEST`] (the set's entries) last, and swaps the staging folder
+//! with `dest`:
+//! - on Linux, `renameat2(RENAME_EXCHANGE)` exchanges the two folders in one system call,
+//!   so at every instant `dest` holds the complete old set or the complete new set; the
+//!   old set, now under the staging name, is then removed;
+//! - where the exchange is not supported (NFS, other systems), `dest` is renamed aside to
+//!   `PARENT/.NAME.old-PID-N` and the staging folder renamed into its place. A kill
+//!   between these two renames leaves no `dest`: the next `OutputSet::new` for that
+//!   folder renames the aside folder back, so the old set returns.
+//!
+//! Staging and aside folders of killed runs (whose PID is no longer alive) are removed by
+//! the next run into the same folder; dropping an uncommitted set (an error, a panic)
+//! removes its staging folder at once. Errors name the final path (`out/x/flux.exr`), never
+//! the staging path.
+//!
+//! The set replaces the whole folder, so `dest` must be new, empty, or hold only what
+//! blutrace wrote there: the entries its manifest names, or (folders written before
+//! manifests existed) names the command itself writes. Anything else is refused with an
+//! error naming it, before tracing when the command calls [`check_dest`] first, and never
+//! deleted.
+//!
+//! Test hooks, for `tests/output_sets.rs` and not meant for users: with
+//! `BLUTRACE_TEST_OUTPUT_PAUSE=STEP` set, a set prints `blutrace-test-hook: STEP` on stderr
+//! at every step (`wrote NAME` after each file, `swap`, `aside` between the two renames,
+//! `swapped`) and stops for a minute at the step named, so that a test can kill the process
+//! exactly there; `BLUTRACE_TEST_OUTPUT_SWAP=two-step` forces the two-rename swap.
+//!
+//! ```no_run
+//! # fn main() -> anyhow::Result<()> {
+//! use blutrace::output::atomic::OutputSet;
+//! let out = OutputSet::new(std::path::Path::new("results"), &["summary.json", "map.png"])?;
+//! out.write_bytes("summary.json", b"{}")?;
+//! out.write_with("map.png", |path| Ok(std::fs::write(path, b"")?))?;
+//! let written = out.commit()?; // results/map.png, results/summary.json
+//! # let _ = written;
+//! # Ok(())
+//! # }
+//! ```
 
-use std::fs::{self, OpenOptions};
+use std::fs;
+use std::io;
+use std::ops::Deref;
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context, Result, bail};
 
-/// Distinguishes temporary names of several `StagedDir`s alive in the same process.
+/// The manifest every output folder gets, written last: `{"software", "entries"}`.
+pub const MANIFEST: &str = ".blutrace-outputs.json";
+
+/// Distinguishes the staging folders of several sets alive in the same process.
 static STAGE_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// One file staged for commit.
-#[derive(Debug)]
-struct Staged {
-    /// The name the caller asked for.
-    name: String,
-    /// Where the writer writes.
-    temp: PathBuf,
-    /// Where the file ends up after [`StagedDir::commit`].
-    dest: PathBuf,
-    /// Already renamed to `dest` (so `Drop` must not touch it).
-    renamed: bool,
-    /// A folder (from [`StagedDir::stage_dir`]) rather than a file.
-    is_dir: bool,
+/// A folder of an output set being written: files go to the staging folder, errors and
+/// returned paths name where they end up.
+#[derive(Debug, Clone)]
+pub struct SetDir {
+    /// Where writers write.
+    staging: PathBuf,
+    /// Where the files end up (as the user gave it), for messages and returned paths.
+    shown: PathBuf,
 }
 
-/// A set of output files written under temporary names inside one directory and moved to
-/// their final names together by [`commit`](StagedDir::commit).
-///
-/// ```no_run
-/// # fn main() -> anyhow::Result<()> {
-/// use blutrace::output::atomic::StagedDir;
-/// let mut out = StagedDir::new(std::path::Path::new("results"))?;
-/// out.write_bytes("summary.json", b"{}")?;
-/// let image = out.stage_path("map.png"); // hand this path to a writer
-/// # std::fs::write(&image, b"")?;
-/// let written = out.commit()?; // results/summary.json, results/map.png
-/// # let _ = written;
-/// # Ok(())
-/// # }
-/// ```
-#[derive(Debug)]
-pub struct StagedDir {
-    dir: PathBuf,
-    staged: Vec<Staged>,
-    /// Problems found by [`stage_path`](Self::stage_path) (which cannot fail), reported by
-    /// [`commit`](Self::commit).
-    errors: Vec<String>,
-}
+impl SetDir {
+    /// Write the file `name` (a plain file name) with `write`, which is handed the path to
+    /// write to; returns the file's final path. Errors of `write` name the final path.
+    pub fn write_with(
+        &self,
+        name: &str,
+        write: impl FnOnce(&Path) -> Result<()>,
+    ) -> Result<PathBuf> {
+        let shown = self.shown.join(name);
+        check_name(name, &shown)?;
+        let temp = self.staging.join(name);
+        write(&temp).map_err(|e| self.final_names(&e))?;
+        if !temp.exists() {
+            bail!("{}: the writer wrote nothing", shown.display());
+        }
+        test_hook(&format!("wrote {name}"));
+        Ok(shown)
+    }
 
-impl StagedDir {
-    /// Prepare to write files into `dir`, creating it (and its parents) if needed, and
-    /// remove the temporaries that killed runs left there (see [`remove_stale`]).
-    pub fn new(dir: &Path) -> Result<Self> {
-        fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
-        remove_stale(dir);
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            staged: Vec::new(),
-            errors: Vec::new(),
+    /// Write `bytes` as the file `name`.
+    pub fn write_bytes(&self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+        self.write_with(name, |p| {
+            fs::write(p, bytes).with_context(|| format!("cannot write {}", p.display()))
         })
     }
 
-    /// The target directory.
-    pub fn dir(&self) -> &Path {
-        &self.dir
+    /// Create the subfolder `name` and return it, to be written like this one.
+    pub fn subdir(&self, name: &str) -> Result<SetDir> {
+        let shown = self.shown.join(name);
+        check_name(name, &shown)?;
+        let staging = self.staging.join(name);
+        fs::create_dir(&staging)
+            .with_context(|| format!("cannot create output folder {}", shown.display()))?;
+        Ok(SetDir { staging, shown })
     }
 
-    /// Reserve the output file `name` (a plain file name, no directory part) and return the
-    /// temporary path inside the target directory that a writer should write it to.
-    ///
-    /// Staging the same name twice returns the same temporary path. An invalid name (empty,
-    /// `.`/`..`, or containing a path separator) still yields a usable temporary path, but
-    /// [`commit`](Self::commit) then fails and nothing is renamed.
-    pub fn stage_path(&mut self, name: &str) -> PathBuf {
-        self.stage(name, false)
+    /// `e`'s message with the staging folder replaced by the final one.
+    fn final_names(&self, e: &anyhow::Error) -> anyhow::Error {
+        let staging = self.staging.display().to_string();
+        let shown = self.shown.display().to_string();
+        anyhow::anyhow!("{}", format!("{e:#}").replace(&staging, &shown))
     }
+}
 
-    /// Reserve the output folder `name` (a plain name, like [`stage_path`](Self::stage_path)'s)
-    /// and return the temporary path a writer should create it at; [`commit`](Self::commit)
-    /// replaces an existing folder of that name with it.
-    pub fn stage_dir(&mut self, name: &str) -> PathBuf {
-        let temp = self.stage(name, true);
-        // A stale folder of the same temporary name must not leak into the output.
-        let _ = fs::remove_dir_all(&temp);
-        temp
+/// The output set of one run: a [`SetDir`] staged beside its destination folder, moved into
+/// place by [`commit`](Self::commit).
+#[derive(Debug)]
+pub struct OutputSet {
+    root: SetDir,
+    /// The destination folder, absolute (a symbolic link resolved).
+    dest: PathBuf,
+    /// Names the command may write, accepted in a folder without a manifest.
+    may_write: Vec<String>,
+    /// Moved into place (so `Drop` must not remove the staging folder).
+    committed: bool,
+}
+
+impl Deref for OutputSet {
+    type Target = SetDir;
+    fn deref(&self) -> &SetDir {
+        &self.root
     }
+}
 
-    /// Reserve `name` as a file or a folder.
-    fn stage(&mut self, name: &str, is_dir: bool) -> PathBuf {
-        if let Some(existing) = self.staged.iter().find(|s| s.name == name) {
-            return existing.temp.clone();
-        }
-        let valid = is_plain_file_name(name);
-        if !valid {
-            self.errors.push(format!(
-                "invalid output file name {name:?}: must be a plain file name without directories"
-            ));
-        }
-        let stem = if valid { name } else { "invalid-name" };
+impl OutputSet {
+    /// Start a set that will replace the folder `dest`. `may_write` lists the names the
+    /// command can write (for [`check_dest`]). Restores or removes what killed runs left
+    /// (see the module documentation), checks `dest` and creates the staging folder.
+    pub fn new(dest: &Path, may_write: &[&str]) -> Result<Self> {
+        let (parent, name) = split_dest(dest)?;
+        recover(&parent, &name, dest);
+        check_dest(dest, may_write)?;
+        let abs = parent.join(&name);
         let n = STAGE_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let temp = self
-            .dir
-            .join(format!(".{stem}.tmp-{}-{n}", std::process::id()));
-        let dest = self.dir.join(if valid { name } else { stem });
-        self.staged.push(Staged {
-            name: name.to_owned(),
-            temp: temp.clone(),
-            dest,
-            renamed: false,
-            is_dir,
-        });
-        temp
+        let staging = parent.join(temp_name(&name, "tmp", std::process::id(), n));
+        fs::create_dir(&staging)
+            .with_context(|| format!("cannot create output folder {}", dest.display()))?;
+        Ok(Self {
+            root: SetDir {
+                staging,
+                shown: dest.to_path_buf(),
+            },
+            dest: abs,
+            may_write: may_write.iter().map(|s| s.to_string()).collect(),
+            committed: false,
+        })
     }
 
-    /// Stage `name` and write `bytes` to its temporary path.
-    pub fn write_bytes(&mut self, name: &str, bytes: &[u8]) -> Result<()> {
-        let temp = self.stage_path(name);
-        fs::write(&temp, bytes)
-            .with_context(|| format!("cannot write {} (staged as {})", name, temp.display()))
-    }
-
-    /// Move every staged file to its final name and return the final paths, in staging
-    /// order.
-    ///
-    /// First every staged file is flushed to disk (`fsync`); if any is missing or cannot be
-    /// synced, nothing is renamed and all temporary files are removed. Then the files are
-    /// renamed one by one (replacing existing files of the same name) and the directory
-    /// itself is synced. Should a rename fail midway, the files renamed so far stay and the
-    /// remaining temporary files are removed.
+    /// Sync every file, write the manifest and replace the destination folder with the set;
+    /// returns the final paths of the set's entries (files and subfolders), sorted.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
-        if !self.errors.is_empty() {
-            bail!("{}", self.errors.join("; "));
+        let shown = self.root.shown.clone();
+        let entries = entry_names(&self.root.staging)?;
+        // A folder changed by someone else since the run began is refused too.
+        let names: Vec<&str> = self.may_write.iter().map(String::as_str).collect();
+        check_dest(&shown, &names)?;
+        let manifest = serde_json::json!({
+            "software": format!("blutrace {}", env!("CARGO_PKG_VERSION")),
+            "entries": entries,
+        });
+        let staging = self.root.staging.clone();
+        fs::write(
+            staging.join(MANIFEST),
+            serde_json::to_vec_pretty(&manifest)?,
+        )
+        .with_context(|| format!("cannot write {}", shown.join(MANIFEST).display()))?;
+        sync_tree(&staging).map_err(|e| {
+            anyhow::anyhow!("cannot sync the outputs in {}: {e}", shown.display())
+        })?;
+        test_hook("swap");
+        let two_step = std::env::var("BLUTRACE_TEST_OUTPUT_SWAP").as_deref() == Ok("two-step");
+        let old = swap_into_place(&staging, &self.dest, two_step)
+            .with_context(|| format!("cannot move the new outputs into {}", shown.display()))?;
+        self.committed = true;
+        if let Some(parent) = self.dest.parent() {
+            sync_dir(parent);
         }
-        for s in &self.staged {
-            if s.is_dir {
-                if !s.temp.is_dir() {
-                    bail!(
-                        "staged output folder {} was never written ({})",
-                        s.name,
-                        s.temp.display()
-                    );
-                }
-                continue;
-            }
-            let file = OpenOptions::new()
-                .write(true)
-                .open(&s.temp)
-                .with_context(|| {
-                    format!(
-                        "staged output {} was never written ({})",
-                        s.name,
-                        s.temp.display()
-                    )
-                })?;
-            file.sync_all()
-                .with_context(|| format!("cannot sync {}", s.temp.display()))?;
+        test_hook("swapped");
+        if let Some(old) = old {
+            // The previous set: blutrace's own files only (check_dest refused anything else).
+            let _ = fs::remove_dir_all(old);
         }
-        for s in &mut self.staged {
-            if s.is_dir && s.dest.is_dir() {
-                fs::remove_dir_all(&s.dest)
-                    .with_context(|| format!("cannot replace {}", s.dest.display()))?;
-            }
-            fs::rename(&s.temp, &s.dest).with_context(|| {
-                format!("cannot rename {} to {}", s.temp.display(), s.dest.display())
-            })?;
-            s.renamed = true;
-        }
-        sync_dir(&self.dir);
-        Ok(self.staged.iter().map(|s| s.dest.clone()).collect())
+        Ok(entries.iter().map(|e| shown.join(e)).collect())
     }
 }
 
-impl Drop for StagedDir {
-    /// Remove the temporary files of everything not committed.
+impl Drop for OutputSet {
+    /// Remove the staging folder of a set never committed.
     fn drop(&mut self) {
-        for s in self.staged.iter().filter(|s| !s.renamed) {
-            // The file may never have been created: ignore errors.
-            if s.is_dir {
-                let _ = fs::remove_dir_all(&s.temp);
-            } else {
-                let _ = fs::remove_file(&s.temp);
-            }
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.root.staging);
         }
     }
 }
 
-/// `name` is a single normal path component.
-/// Remove the temporaries (`.NAME.tmp-PID-N`) in `dir` whose process is gone: what a run
-/// killed while writing (SIGKILL, power loss) left behind, which no `Drop` could delete.
-/// A live process's temporaries are left alone (Linux: `/proc/PID` exists; elsewhere only
-/// this process's own are known to be alive, so nothing of another PID is kept). Runs on
-/// other machines writing into the same shared folder at the same time cannot be seen:
-/// give every run (every shard) its own output folder, as `trace --shard` usage does.
-pub fn remove_stale(dir: &Path) {
-    let Ok(entries) = fs::read_dir(dir) else {
+/// Refuse an output folder the set could not replace without losing something: a file
+/// that is not a folder, a folder holding entries blutrace did not write (neither named by
+/// its manifest nor in `may_write` nor a blutrace temporary), the current directory, or a
+/// mount point. A folder that does not exist yet is fine.
+pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
+    let shown = dest.display();
+    let meta = match fs::metadata(dest) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => bail!("{shown}: cannot read the output folder: {e}"),
+        Ok(m) => m,
+    };
+    if !meta.is_dir() {
+        bail!("{shown}: exists and is not a folder; give --out a folder");
+    }
+    let real = fs::canonicalize(dest).with_context(|| format!("{shown}: cannot resolve"))?;
+    if std::env::current_dir().and_then(fs::canonicalize).ok() == Some(real.clone()) {
+        bail!(
+            "{shown}: is the current directory, which the new output set would replace; give --out a folder inside it"
+        );
+    }
+    if is_mount_point(&real) {
+        bail!("{shown}: is a mount point, which cannot be replaced; give --out a folder inside it");
+    }
+    let mut ours: Vec<String> = may_write.iter().map(|s| s.to_string()).collect();
+    ours.extend(manifest_entries(&real));
+    let mut foreign: Vec<String> = Vec::new();
+    for e in fs::read_dir(&real).with_context(|| format!("{shown}: cannot list"))? {
+        let n = e?.file_name().to_string_lossy().into_owned();
+        if n != MANIFEST && !ours.contains(&n) && parse_temp(&n).is_none() {
+            foreign.push(n);
+        }
+    }
+    if !foreign.is_empty() {
+        foreign.sort();
+        let more = if foreign.len() > 5 { ", ..." } else { "" };
+        foreign.truncate(5);
+        bail!(
+            "{shown}: holds {} that blutrace did not write; a run replaces the whole output folder, so move them or give --out a new folder",
+            foreign.join(", ") + more
+        );
+    }
+    Ok(())
+}
+
+/// The entries named by `dir`'s manifest (none without one).
+fn manifest_entries(dir: &Path) -> Vec<String> {
+    let Ok(text) = fs::read_to_string(dir.join(MANIFEST)) else {
+        return Vec::new();
+    };
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+    v["entries"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|e| e.as_str().map(str::to_owned))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// `dest`'s parent folder (absolute, created if needed, symbolic links resolved) and name.
+fn split_dest(dest: &Path) -> Result<(PathBuf, String)> {
+    let resolved = match fs::canonicalize(dest) {
+        Ok(p) => p,
+        Err(_) => {
+            let name = dest
+                .file_name()
+                .with_context(|| format!("{}: not a folder name", dest.display()))?;
+            let parent = match dest.parent() {
+                Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+                _ => PathBuf::from("."),
+            };
+            fs::create_dir_all(&parent).with_context(|| {
+                format!("cannot create output folder {}", parent.display())
+            })?;
+            fs::canonicalize(&parent)
+                .with_context(|| format!("cannot resolve {}", parent.display()))?
+                .join(name)
+        }
+    };
+    match (resolved.parent(), resolved.file_name()) {
+        (Some(p), Some(n)) => Ok((p.to_path_buf(), n.to_string_lossy().into_owned())),
+        _ => bail!("{}: cannot be an output folder", dest.display()),
+    }
+}
+
+/// Undo or clean up what killed runs into `PARENT/NAME` left: an aside folder (the old set
+/// of a two-rename swap) goes back into place when `NAME` is missing, and is removed
+/// otherwise; staging folders are removed. Only temporaries of dead processes are touched.
+/// Best effort: a failure here shows up as an error when the set is written.
+fn recover(parent: &Path, name: &str, shown: &Path) {
+    let Ok(list) = fs::read_dir(parent) else {
         return;
     };
-    let me = std::process::id();
-    for e in entries.flatten() {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let Some(pid) = stale_pid(&name) else {
-            continue;
-        };
-        let alive = pid == me || Path::new(&format!("/proc/{pid}")).exists();
-        if !alive {
-            let p = e.path();
-            let _ = fs::remove_dir_all(&p).or_else(|_| fs::remove_file(&p));
+    let dest = parent.join(name);
+    let mut stale: Vec<(String, PathBuf)> = Vec::new();
+    for e in list.flatten() {
+        let entry = e.file_name().to_string_lossy().into_owned();
+        if let Some((of, kind, pid)) = parse_temp(&entry)
+            && of == name
+            && !is_alive(pid)
+        {
+            stale.push((kind.to_owned(), e.path()));
         }
+    }
+    // Restore first, so that the old set is back before anything is removed.
+    stale.sort_by_key(|(kind, _)| kind != "old");
+    for (kind, path) in stale {
+        if kind == "old" && !dest.exists() {
+            if fs::rename(&path, &dest).is_ok() {
+                eprintln!(
+                    "note: restored the previous outputs of {} that a killed run had moved aside",
+                    shown.display()
+                );
+            }
+            continue;
+        }
+        let _ = fs::remove_dir_all(&path).or_else(|_| fs::remove_file(&path));
     }
 }
 
-/// The PID in a temporary name `.NAME.tmp-PID-N`, if `name` is one.
-fn stale_pid(name: &str) -> Option<u32> {
-    let rest = name.strip_prefix('.')?;
-    let (_, tail) = rest.rsplit_once(".tmp-")?;
-    let (pid, n) = tail.split_once('-')?;
+/// Move `staging` to `dest`, replacing what is there, by an exchange or (`two_step`, or
+/// when the exchange is not supported) two renames; returns where the previous folder went
+/// (to be removed), if there was one.
+fn swap_into_place(staging: &Path, dest: &Path, two_step: bool) -> io::Result<Option<PathBuf>> {
+    if fs::symlink_metadata(dest).is_err() {
+        fs::rename(staging, dest)?;
+        return Ok(None);
+    }
+    if !two_step && exchange(staging, dest)? {
+        return Ok(Some(staging.to_path_buf()));
+    }
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let n = STAGE_COUNTER.fetch_add(1, Ordering::Relaxed);
+    let aside = dest.with_file_name(temp_name(&name, "old", std::process::id(), n));
+    fs::rename(dest, &aside)?;
+    test_hook("aside");
+    if let Err(e) = fs::rename(staging, dest) {
+        let _ = fs::rename(&aside, dest);
+        return Err(e);
+    }
+    Ok(Some(aside))
+}
+
+/// Exchange the folders `a` and `b` atomically; `Ok(false)` when the file system or system
+/// cannot.
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn exchange(a: &Path, b: &Path) -> io::Result<bool> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    use rustix::io::Errno;
+    match renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE) {
+        Ok(()) => Ok(true),
+        Err(Errno::INVAL | Errno::NOSYS | Errno::OPNOTSUPP | Errno::PERM) => Ok(false),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// Exchange the folders `a` and `b` atomically; `Ok(false)` when the file system or system
+/// cannot.
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn exchange(_a: &Path, _b: &Path) -> io::Result<bool> {
+    Ok(false)
+}
+
+/// `.NAME.KIND-PID-N`: the staging (`tmp`) or aside (`old`) folder of `NAME`.
+fn temp_name(name: &str, kind: &str, pid: u32, n: u64) -> String {
+    format!(".{name}.{kind}-{pid}-{n}")
+}
+
+/// The parts `(NAME, KIND, PID)` of a temporary name `.NAME.KIND-PID-N` (also the
+/// per-file temporaries of earlier versions, `.FILE.tmp-PID-N`).
+fn parse_temp(entry: &str) -> Option<(&str, &str, u32)> {
+    let rest = entry.strip_prefix('.')?;
+    let (name, tail) = rest.rsplit_once('.')?;
+    let (kind, ids) = tail.split_once('-')?;
+    if kind != "tmp" && kind != "old" {
+        return None;
+    }
+    let (pid, n) = ids.split_once('-')?;
     n.parse::<u64>().ok()?;
-    pid.parse().ok()
+    Some((name, kind, pid.parse().ok()?))
 }
 
-fn is_plain_file_name(name: &str) -> bool {
-    let mut components = Path::new(name).components();
-    matches!((components.next(), components.next()), (Some(Component::Normal(c)), None) if c == name)
+/// Linux: `/proc/PID` exists. Elsewhere only this process is known to be alive, so other
+/// runs writing into the same folder at the same time are not seen; nor are runs on other
+/// machines sharing the folder: give every run (every shard) its own output folder.
+fn is_alive(pid: u32) -> bool {
+    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
 }
 
-/// Make the renames durable. Best effort: not every platform can open a directory for sync.
+/// The sorted entry names of `dir`.
+fn entry_names(dir: &Path) -> Result<Vec<String>> {
+    let mut v: Vec<String> = fs::read_dir(dir)?
+        .map(|e| Ok(e?.file_name().to_string_lossy().into_owned()))
+        .collect::<io::Result<_>>()?;
+    v.sort();
+    Ok(v)
+}
+
+/// Flush every file and folder under `dir` to disk.
+fn sync_tree(dir: &Path) -> io::Result<()> {
+    for e in fs::read_dir(dir)? {
+        let e = e?;
+        if e.file_type()?.is_dir() {
+            sync_tree(&e.path())?;
+        } else {
+            fs::File::open(e.path())?.sync_all()?;
+        }
+    }
+    sync_dir(dir);
+    Ok(())
+}
+
+/// A plain file name: one normal path component.
+fn check_name(name: &str, shown: &Path) -> Result<()> {
+    let mut c = Path::new(name).components();
+    match (c.next(), c.next()) {
+        (Some(Component::Normal(n)), None) if n == name && name != MANIFEST => Ok(()),
+        _ => bail!(
+            "{}: invalid output name {name:?}: must be a plain file name",
+            shown.display()
+        ),
+    }
+}
+
+/// `dir` is on another device than its parent.
+fn is_mount_point(dir: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let dev = |p: &Path| fs::metadata(p).map(|m| m.dev()).ok();
+        match dir.parent() {
+            Some(parent) => dev(dir) != dev(parent),
+            None => true,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        dir.parent().is_none()
+    }
+}
+
+/// Make renames in `dir` durable. Best effort: not every platform can sync a directory.
 fn sync_dir(dir: &Path) {
     #[cfg(unix)]
     if let Ok(d) = fs::File::open(dir) {
@@ -243,150 +457,17 @@ fn sync_dir(dir: &Path) {
     let _ = dir;
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A fresh empty directory under the system temp dir, removed on drop.
-    struct TestDir(PathBuf);
-
-    impl TestDir {
-        fn new(tag: &str) -> Self {
-            let n = STAGE_COUNTER.fetch_add(1, Ordering::Relaxed);
-            let p = std::env::temp_dir()
-                .join(format!("blutrace-atomic-{tag}-{}-{n}", std::process::id()));
-            let _ = fs::remove_dir_all(&p);
-            Self(p)
-        }
-
-        fn listing(&self) -> Vec<String> {
-            let mut v: Vec<String> = fs::read_dir(&self.0)
-                .unwrap()
-                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect();
-            v.sort();
-            v
-        }
-    }
-
-    impl Drop for TestDir {
-        fn drop(&mut self) {
-            let _ = fs::remove_dir_all(&self.0);
-        }
-    }
-
-    #[test]
-    fn drop_without_commit_leaves_nothing() {
-        let t = TestDir::new("drop");
-        {
-            let mut s = StagedDir::new(&t.0.join("sub")).unwrap();
-            s.write_bytes("a.json", b"{}").unwrap();
-            let p = s.stage_path("b.png");
-            assert_eq!(p.parent(), Some(t.0.join("sub").as_path()));
-            fs::write(&p, b"partial").unwrap();
-            let _never_written = s.stage_path("c.exr");
-            assert_eq!(fs::read_dir(t.0.join("sub")).unwrap().count(), 2);
-        }
-        assert_eq!(fs::read_dir(t.0.join("sub")).unwrap().count(), 0);
-    }
-
-    #[test]
-    fn commit_leaves_exactly_the_final_files() {
-        let t = TestDir::new("commit");
-        fs::create_dir_all(&t.0).unwrap();
-        fs::write(t.0.join("a.json"), b"old").unwrap();
-        let mut s = StagedDir::new(&t.0).unwrap();
-        s.write_bytes("a.json", b"new").unwrap();
-        let p = s.stage_path("b.bin");
-        assert!(
-            p.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(".b.bin.tmp-")
-        );
-        fs::write(&p, [1u8, 2, 3]).unwrap();
-        assert_eq!(s.stage_path("b.bin"), p, "restaging returns the same path");
-        let done = s.commit().unwrap();
-        assert_eq!(done, vec![t.0.join("a.json"), t.0.join("b.bin")]);
-        assert_eq!(t.listing(), vec!["a.json", "b.bin"]);
-        assert_eq!(fs::read(t.0.join("a.json")).unwrap(), b"new");
-        assert_eq!(fs::read(t.0.join("b.bin")).unwrap(), [1, 2, 3]);
-    }
-
-    #[test]
-    fn commit_fails_cleanly_when_a_file_was_never_written() {
-        let t = TestDir::new("missing");
-        let mut s = StagedDir::new(&t.0).unwrap();
-        s.write_bytes("a.json", b"{}").unwrap();
-        let _ = s.stage_path("never.png");
-        let err = s.commit().unwrap_err();
-        assert!(format!("{err:#}").contains("never.png"), "{err:#}");
-        assert!(t.listing().is_empty(), "{:?}", t.listing());
-    }
-
-    #[test]
-    fn staged_folders_replace_old_ones_or_vanish() {
-        let t = TestDir::new("dirs");
-        fs::create_dir_all(t.0.join("run")).unwrap();
-        fs::write(t.0.join("run").join("old.txt"), b"old").unwrap();
-        let mut s = StagedDir::new(&t.0).unwrap();
-        s.write_bytes("a.json", b"{}").unwrap();
-        let run = s.stage_dir("run");
-        let mut inner = StagedDir::new(&run).unwrap();
-        inner.write_bytes("new.txt", b"new").unwrap();
-        inner.commit().unwrap();
-        let done = s.commit().unwrap();
-        assert_eq!(done, vec![t.0.join("a.json"), t.0.join("run")]);
-        assert_eq!(t.listing(), vec!["a.json", "run"]);
-        let run_listing: Vec<_> = fs::read_dir(t.0.join("run")).unwrap().collect();
-        assert_eq!(run_listing.len(), 1);
-        assert_eq!(fs::read(t.0.join("run").join("new.txt")).unwrap(), b"new");
-
-        let mut s = StagedDir::new(&t.0).unwrap();
-        let never = s.stage_dir("never");
-        assert!(s.commit().is_err(), "a folder never written is an error");
-        assert!(!never.exists());
-        {
-            let mut s = StagedDir::new(&t.0).unwrap();
-            let dropped = s.stage_dir("dropped");
-            fs::create_dir_all(dropped.join("sub")).unwrap();
-        }
-        assert_eq!(t.listing(), vec!["a.json", "run"]);
-    }
-
-    #[test]
-    fn invalid_names_are_rejected_at_commit() {
-        let t = TestDir::new("invalid");
-        for bad in ["", "..", ".", "x/y", "/abs"] {
-            let mut s = StagedDir::new(&t.0).unwrap();
-            s.write_bytes("ok.txt", b"1").unwrap();
-            let p = s.stage_path(bad);
-            assert_eq!(p.parent(), Some(t.0.as_path()));
-            fs::write(&p, b"2").unwrap();
-            assert!(s.commit().is_err(), "{bad:?} accepted");
-            assert!(t.listing().is_empty(), "{bad:?}: {:?}", t.listing());
-        }
-    }
-
-    #[test]
-    fn temporaries_of_dead_runs_are_removed_and_live_ones_kept() {
-        let t = TestDir::new("stale");
-        fs::create_dir_all(&t.0).unwrap();
-        // PID 2^31 - 1 is above Linux's pid_max: never a live process.
-        let dead = t.0.join(".flux.exr.tmp-2147483647-3");
-        let dead_dir = t.0.join(".final.tmp-2147483647-4");
-        let mine =
-            t.0.join(format!(".summary.json.tmp-{}-9", std::process::id()));
-        let other = t.0.join(".notes.tmp-x-1");
-        fs::write(&dead, b"half").unwrap();
-        fs::create_dir(&dead_dir).unwrap();
-        fs::write(dead_dir.join("a"), b"x").unwrap();
-        fs::write(&mine, b"in progress").unwrap();
-        fs::write(&other, b"not ours").unwrap();
-        let _s = StagedDir::new(&t.0).unwrap();
-        assert!(!dead.exists() && !dead_dir.exists());
-        assert!(mine.exists() && other.exists());
-        assert_eq!(stale_pid(".flux.exr.tmp-12-0"), Some(12));
-        assert_eq!(stale_pid("flux.exr"), None);
+/// The test hook of the module documentation.
+fn test_hook(step: &str) {
+    let Ok(pause_at) = std::env::var("BLUTRACE_TEST_OUTPUT_PAUSE") else {
+        return;
+    };
+    eprintln!("blutrace-test-hook: {step}");
+    if pause_at == step {
+        std::thread::sleep(std::time::Duration::from_secs(60));
     }
 }
+
+#[cfg(test)]
+#[path = "atomic_tests.rs"]
+mod tests;

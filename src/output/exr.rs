@@ -36,7 +36,7 @@ pub type ChannelImage = (usize, usize, Vec<(String, Vec<f32>)>, Vec<(String, f64
 /// `dataWindow`); values are stored as EXR `double`. Compression is lossless ZIP.
 ///
 /// The same arguments always give the same bytes. The file is written directly to `path`; use
-/// [`StagedDir`](crate::output::atomic::StagedDir) for all-or-nothing output.
+/// [`OutputSet`](crate::output::atomic::OutputSet) for all-or-nothing output.
 pub fn write_channels(
     path: &Path,
     width: usize,

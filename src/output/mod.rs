@@ -1,8 +1,8 @@
 //! Writing results to disk: generic, scene-agnostic writers.
 //!
-//! - [`atomic`]: [`atomic::StagedDir`] stages every output file of a run under a temporary
-//!   name and renames them into place only when the whole run succeeded, so a failed run
-//!   never leaves a half-written file behind.
+//! - [`atomic`]: [`atomic::OutputSet`] writes every output file of a run into a staging
+//!   folder that replaces the output folder in one step once the whole set is written, so
+//!   the folder always holds one complete set (the previous or the new one).
 //! - [`exr`]: multi-channel 32-bit float OpenEXR images (lossless ZIP compression) with
 //!   numeric header attributes, plus a reader for the files it writes.
 //! - [`png`]: false-colour previews (viridis colour map with a colour bar) for people.

@@ -25,7 +25,10 @@ pub mod summary;
 
 use crate::accel::{self, Accel, BackendChoice};
 use crate::optics::surface::Estimator;
-use crate::output::{self, atomic::StagedDir};
+use crate::output::{
+    self,
+    atomic::{OutputSet, SetDir},
+};
 use crate::scene::Scene;
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
@@ -377,6 +380,16 @@ fn relative_error(m: Metric, value: f64, stderr: f64) -> f64 {
     }
 }
 
+/// Every file `blutrace trace` and `merge` write.
+pub const OUTPUT_NAMES: &[&str] = &[
+    "flux.exr",
+    "angular.exr",
+    "flux.png",
+    "convergence.csv",
+    "convergence.png",
+    "summary.json",
+];
+
 impl RunResult<'_> {
     /// Target-plane irradiance (W/mm^2) per bin.
     pub fn flux_map(&self) -> Map {
@@ -398,9 +411,16 @@ impl RunResult<'_> {
         self.history.last()
     }
 
-    /// Write every output into `dir` atomically; returns the files written.
+    /// Write every output into `dir` as one set ([`OutputSet`]): the folder holds the
+    /// previous set until the new one is complete; returns the files written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        let mut staged = StagedDir::new(dir)?;
+        let set = OutputSet::new(dir, OUTPUT_NAMES)?;
+        self.write_into(&set)?;
+        set.commit()
+    }
+
+    /// Write every output into `staged`, a folder of an output set.
+    pub fn write_into(&self, staged: &SetDir) -> Result<()> {
         let flux = self.flux_map();
         let d = &self.scene.detector;
         let bin = d.bin_size();
@@ -417,7 +437,7 @@ impl RunResult<'_> {
             common[1],
         ];
         write_map_exr(
-            &mut staged,
+            staged,
             "flux.exr",
             &flux,
             ["flux", "flux_stderr"],
@@ -432,35 +452,37 @@ impl RunResult<'_> {
             common[1],
         ];
         let lum = metrics::luminance_map(self.scene, &self.tally);
-        write_angular_exr(&mut staged, &ang, lum.as_ref(), &ang_attrs)?;
-        let png = staged.stage_path("flux.png");
+        write_angular_exr(staged, &ang, lum.as_ref(), &ang_attrs)?;
         let d = &self.scene.detector;
-        output::png::write_false_colour(
-            &png,
-            flux.nx,
-            flux.ny,
-            &flux.value,
-            &output::png::PreviewOptions {
-                extent_mm: Some(d.size),
-                unit: Some("W/mm^2"),
-                ..Default::default()
-            },
-        )?;
+        staged.write_with("flux.png", |png| {
+            output::png::write_false_colour(
+                png,
+                flux.nx,
+                flux.ny,
+                &flux.value,
+                &output::png::PreviewOptions {
+                    extent_mm: Some(d.size),
+                    unit: Some("W/mm^2"),
+                    ..Default::default()
+                },
+            )
+        })?;
         staged.write_bytes(
             "convergence.csv",
             summary::convergence_csv(&self.history).as_bytes(),
         )?;
-        let chart = staged.stage_path("convergence.png");
-        summary::write_convergence_png(&chart, &self.history)?;
+        staged.write_with("convergence.png", |chart| {
+            summary::write_convergence_png(chart, &self.history)
+        })?;
         let json = serde_json::to_vec_pretty(&self.summary())?;
         staged.write_bytes("summary.json", &json)?;
-        staged.commit()
+        Ok(())
     }
 }
 
 /// angular.exr: intensity (W/sr), and luminance (cd/m^2) when the sources give lumens.
 fn write_angular_exr(
-    staged: &mut StagedDir,
+    staged: &SetDir,
     ang: &Map,
     lum: Option<&Map>,
     attrs: &[(&str, f64)],
@@ -477,12 +499,14 @@ fn write_angular_exr(
     if lum.is_some() {
         channels.extend([("luminance", &l[..]), ("luminance_stderr", &le[..])]);
     }
-    let path = staged.stage_path("angular.exr");
-    output::exr::write_channels(&path, ang.nx, ang.ny, &channels, attrs)
+    staged.write_with("angular.exr", |path| {
+        output::exr::write_channels(path, ang.nx, ang.ny, &channels, attrs)
+    })?;
+    Ok(())
 }
 
 fn write_map_exr(
-    staged: &mut StagedDir,
+    staged: &SetDir,
     name: &str,
     m: &Map,
     names: [&str; 2],
@@ -491,12 +515,14 @@ fn write_map_exr(
     let as_f32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
     let (value, stderr) = (as_f32(&m.value), as_f32(&m.stderr));
     let hits: Vec<f32> = m.hits.iter().map(|&h| h as f32).collect();
-    let path = staged.stage_path(name);
-    output::exr::write_channels(
-        &path,
-        m.nx,
-        m.ny,
-        &[(names[0], &value), (names[1], &stderr), ("hits", &hits)],
-        attrs,
-    )
+    staged.write_with(name, |path| {
+        output::exr::write_channels(
+            path,
+            m.nx,
+            m.ny,
+            &[(names[0], &value), (names[1], &stderr), ("hits", &hits)],
+            attrs,
+        )
+    })?;
+    Ok(())
 }

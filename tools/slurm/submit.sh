@@ -4,8 +4,8 @@
 #
 #   tools/slurm/submit.sh SCENE PHOTONS SHARDS OUT [SEED]
 #
-# Writes OUT/shards/K/shard.json (one per task), the merged outputs of the run in OUT
-# (flux.exr, angular.exr, flux.png, convergence.csv/png, summary.json) and the jobs' logs
+# Writes OUT/shards/K/shard.json (one per task), the merged outputs of the run in
+# OUT/merged (flux.exr, angular.exr, flux.png, convergence.csv/png, summary.json) and the jobs' logs
 # in OUT/logs. Prints the job ids as "array_job=ID" and "merge_job=ID" lines on stdout.
 # SEED defaults to 1 (the default [trace] seed of scenes); give it to be explicit.
 #

@@ -294,7 +294,7 @@ t0=$SECONDS
 grep '^time' "$WORK/log/reference.out" | sed 's/^/    /'
 log "reference (one process) done in $((SECONDS - t0)) s"
 
-if ! python3 - "$run" "$ref" <<'EOF'
+if ! python3 - "$run/merged" "$ref" <<'EOF'
 import json, sys
 from pathlib import Path
 

@@ -1,0 +1,161 @@
+//! Unit tests of output sets: staging, swap, refusal of foreign entries, recovery.
+
+use super::*;
+
+/// A fresh temporary parent folder.
+fn parent(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("blutrace-atomic-{tag}-"))
+        .tempdir()
+        .unwrap()
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    entry_names(dir).unwrap()
+}
+
+const NAMES: &[&str] = &["a.json", "b.bin", "run"];
+
+#[test]
+fn drop_without_commit_leaves_nothing() {
+    let t = parent("drop");
+    let dest = t.path().join("out");
+    {
+        let s = OutputSet::new(&dest, NAMES).unwrap();
+        s.write_bytes("a.json", b"{}").unwrap();
+        assert_eq!(listing(t.path()).len(), 1, "the staging folder");
+    }
+    assert!(listing(t.path()).is_empty(), "{:?}", listing(t.path()));
+}
+
+#[test]
+fn commit_replaces_the_whole_previous_set() {
+    let t = parent("commit");
+    let dest = t.path().join("out");
+    let s = OutputSet::new(&dest, NAMES).unwrap();
+    s.write_bytes("a.json", b"old").unwrap();
+    s.write_bytes("b.bin", b"old").unwrap();
+    s.commit().unwrap();
+    assert_eq!(listing(&dest), vec![MANIFEST, "a.json", "b.bin"]);
+
+    let s = OutputSet::new(&dest, NAMES).unwrap();
+    s.write_bytes("a.json", b"new").unwrap();
+    let run = s.subdir("run").unwrap();
+    run.write_bytes("inner.txt", b"x").unwrap();
+    let done = s.commit().unwrap();
+    assert_eq!(done, vec![dest.join("a.json"), dest.join("run")]);
+    // b.bin of the previous set is gone: the folder holds exactly the new set.
+    assert_eq!(listing(&dest), vec![MANIFEST, "a.json", "run"]);
+    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"new");
+    assert_eq!(fs::read(dest.join("run/inner.txt")).unwrap(), b"x");
+    assert_eq!(manifest_entries(&dest), vec!["a.json", "run"]);
+    assert_eq!(listing(t.path()), vec!["out"], "no staging or old folder left");
+}
+
+#[test]
+fn the_two_rename_swap_gives_the_same_result() {
+    let t = parent("two-step");
+    let dest = t.path().join("out");
+    fs::create_dir(&dest).unwrap();
+    fs::write(dest.join("a.json"), b"old").unwrap();
+    let staging = t.path().join(".out.tmp-1-1");
+    fs::create_dir(&staging).unwrap();
+    fs::write(staging.join("a.json"), b"new").unwrap();
+    let old = swap_into_place(&staging, &dest, true).unwrap().unwrap();
+    assert!(old.file_name().unwrap().to_string_lossy().starts_with(".out.old-"));
+    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"new");
+    assert_eq!(fs::read(old.join("a.json")).unwrap(), b"old");
+    assert!(!staging.exists());
+}
+
+#[test]
+fn foreign_entries_are_refused_and_kept() {
+    let t = parent("foreign");
+    let dest = t.path().join("out");
+    fs::create_dir(&dest).unwrap();
+    fs::write(dest.join("a.json"), b"legacy").unwrap();
+    fs::write(dest.join("notes.md"), b"mine").unwrap();
+    let err = OutputSet::new(&dest, NAMES).unwrap_err().to_string();
+    assert!(err.contains("notes.md") && err.contains(&*dest.to_string_lossy()), "{err}");
+    assert!(!err.contains("a.json"), "a name the command writes is not foreign: {err}");
+    assert_eq!(listing(&dest), vec!["a.json", "notes.md"]);
+    assert_eq!(listing(t.path()), vec!["out"], "nothing staged");
+
+    // Without the foreign file, the legacy folder (no manifest) is replaced.
+    fs::remove_file(dest.join("notes.md")).unwrap();
+    let s = OutputSet::new(&dest, NAMES).unwrap();
+    s.write_bytes("b.bin", b"1").unwrap();
+    // A file appearing while the run writes is refused at commit too, and survives.
+    fs::write(dest.join("late.txt"), b"mine").unwrap();
+    let err = s.commit().unwrap_err().to_string();
+    assert!(err.contains("late.txt"), "{err}");
+    assert_eq!(listing(&dest), vec!["a.json", "late.txt"]);
+    assert_eq!(listing(t.path()), vec!["out"]);
+
+    let file = t.path().join("file");
+    fs::write(&file, b"").unwrap();
+    let err = OutputSet::new(&file, NAMES).unwrap_err().to_string();
+    assert!(err.contains("not a folder"), "{err}");
+}
+
+#[test]
+fn errors_name_the_final_path() {
+    let t = parent("errors");
+    let dest = t.path().join("out");
+    let s = OutputSet::new(&dest, NAMES).unwrap();
+    let err = s
+        .write_with("a.json", |p| {
+            fs::write(p.join("no-such-folder/x"), b"")
+                .with_context(|| format!("cannot create {}", p.display()))
+        })
+        .unwrap_err()
+        .to_string();
+    let want = format!("cannot create {}", dest.join("a.json").display());
+    assert!(err.contains(&want), "{err}");
+    assert!(!err.contains(".tmp-"), "{err}");
+    let err = s.write_with("b.bin", |_| Ok(())).unwrap_err().to_string();
+    assert!(err.contains(&*dest.join("b.bin").to_string_lossy()), "{err}");
+    for bad in ["", "..", ".", "x/y", "/abs", MANIFEST] {
+        assert!(s.write_bytes(bad, b"1").is_err(), "{bad:?} accepted");
+    }
+}
+
+#[test]
+fn what_killed_runs_left_is_restored_or_removed() {
+    // PID 2^31 - 1 is above Linux's pid_max: never a live process.
+    let dead = 2_147_483_647;
+    let t = parent("recover");
+    let dest = t.path().join("out");
+    // A kill between the two renames: the old set aside, no folder in place, a staging
+    // folder with the complete new set.
+    let aside = t.path().join(temp_name("out", "old", dead, 1));
+    fs::create_dir(&aside).unwrap();
+    fs::write(aside.join("a.json"), b"old").unwrap();
+    let staged = t.path().join(temp_name("out", "tmp", dead, 0));
+    fs::create_dir(&staged).unwrap();
+    fs::write(staged.join("a.json"), b"new").unwrap();
+    // Another folder's staging and a live run's staging are not ours to touch.
+    let other = t.path().join(temp_name("other", "tmp", dead, 2));
+    let live = t.path().join(temp_name("out", "tmp", std::process::id(), 99));
+    fs::create_dir(&other).unwrap();
+    fs::create_dir(&live).unwrap();
+    recover(t.path(), "out", &dest);
+    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"old", "old set restored");
+    assert!(!aside.exists() && !staged.exists());
+    assert!(other.exists() && live.exists());
+
+    // With the folder in place, a dead aside folder is the previous set: removed.
+    fs::create_dir(&aside).unwrap();
+    recover(t.path(), "out", &dest);
+    assert!(!aside.exists());
+    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"old");
+}
+
+#[test]
+fn temporary_names_parse() {
+    assert_eq!(parse_temp(".flux.exr.tmp-12-0"), Some(("flux.exr", "tmp", 12)));
+    assert_eq!(parse_temp(".run.v2.old-7-3"), Some(("run.v2", "old", 7)));
+    assert_eq!(parse_temp("flux.exr"), None);
+    assert_eq!(parse_temp(".notes.tmp-x-1"), None);
+    assert_eq!(parse_temp(".a.new-1-1"), None);
+}

@@ -66,16 +66,21 @@ fn kill_at(seed: u64, out: &Path, step: &str, two_step: bool) {
     let mut child = cmd.spawn().unwrap();
     let want = format!("blutrace-test-hook: {step}");
     let mut seen = Vec::new();
+    let mut reached = false;
     for line in BufReader::new(child.stderr.take().unwrap()).lines() {
         let line = line.unwrap();
         if line == want {
+            reached = true;
             child.kill().unwrap(); // SIGKILL: no destructor runs
-            child.wait().unwrap();
-            return;
+            break;
         }
         seen.push(line);
     }
-    panic!("the run never reached step {step:?}; stderr: {seen:#?}");
+    child.wait().unwrap();
+    assert!(
+        reached,
+        "the run never reached step {step:?}; stderr: {seen:#?}"
+    );
 }
 
 /// The entries of `parent` other than the output folder: temporaries of killed runs.

@@ -59,10 +59,10 @@ mod verify;
 mod write;
 
 pub use options::{Method, OptimizeOptions};
-pub use write::OUTPUT_NAMES;
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};
 pub use search::violation;
+pub use write::OUTPUT_NAMES;
 
 use crate::scene::Scene;
 use anyhow::{Result, bail};

@@ -173,9 +173,8 @@ impl OutputSet {
             serde_json::to_vec_pretty(&manifest)?,
         )
         .with_context(|| format!("cannot write {}", shown.join(MANIFEST).display()))?;
-        sync_tree(&staging).map_err(|e| {
-            anyhow::anyhow!("cannot sync the outputs in {}: {e}", shown.display())
-        })?;
+        sync_tree(&staging)
+            .map_err(|e| anyhow::anyhow!("cannot sync the outputs in {}: {e}", shown.display()))?;
         test_hook("swap");
         let two_step = std::env::var("BLUTRACE_TEST_OUTPUT_SWAP").as_deref() == Ok("two-step");
         let old = swap_into_place(&staging, &self.dest, two_step)
@@ -274,9 +273,8 @@ fn split_dest(dest: &Path) -> Result<(PathBuf, String)> {
                 Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
                 _ => PathBuf::from("."),
             };
-            fs::create_dir_all(&parent).with_context(|| {
-                format!("cannot create output folder {}", parent.display())
-            })?;
+            fs::create_dir_all(&parent)
+                .with_context(|| format!("cannot create output folder {}", parent.display()))?;
             fs::canonicalize(&parent)
                 .with_context(|| format!("cannot resolve {}", parent.display()))?
                 .join(name)

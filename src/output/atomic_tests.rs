@@ -49,7 +49,11 @@ fn commit_replaces_the_whole_previous_set() {
     assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"new");
     assert_eq!(fs::read(dest.join("run/inner.txt")).unwrap(), b"x");
     assert_eq!(manifest_entries(&dest), vec!["a.json", "run"]);
-    assert_eq!(listing(t.path()), vec!["out"], "no staging or old folder left");
+    assert_eq!(
+        listing(t.path()),
+        vec!["out"],
+        "no staging or old folder left"
+    );
 }
 
 #[test]
@@ -62,7 +66,12 @@ fn the_two_rename_swap_gives_the_same_result() {
     fs::create_dir(&staging).unwrap();
     fs::write(staging.join("a.json"), b"new").unwrap();
     let old = swap_into_place(&staging, &dest, true).unwrap().unwrap();
-    assert!(old.file_name().unwrap().to_string_lossy().starts_with(".out.old-"));
+    assert!(
+        old.file_name()
+            .unwrap()
+            .to_string_lossy()
+            .starts_with(".out.old-")
+    );
     assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"new");
     assert_eq!(fs::read(old.join("a.json")).unwrap(), b"old");
     assert!(!staging.exists());
@@ -76,8 +85,14 @@ fn foreign_entries_are_refused_and_kept() {
     fs::write(dest.join("a.json"), b"legacy").unwrap();
     fs::write(dest.join("notes.md"), b"mine").unwrap();
     let err = OutputSet::new(&dest, NAMES).unwrap_err().to_string();
-    assert!(err.contains("notes.md") && err.contains(&*dest.to_string_lossy()), "{err}");
-    assert!(!err.contains("a.json"), "a name the command writes is not foreign: {err}");
+    assert!(
+        err.contains("notes.md") && err.contains(&*dest.to_string_lossy()),
+        "{err}"
+    );
+    assert!(
+        !err.contains("a.json"),
+        "a name the command writes is not foreign: {err}"
+    );
     assert_eq!(listing(&dest), vec!["a.json", "notes.md"]);
     assert_eq!(listing(t.path()), vec!["out"], "nothing staged");
 
@@ -114,7 +129,10 @@ fn errors_name_the_final_path() {
     assert!(err.contains(&want), "{err}");
     assert!(!err.contains(".tmp-"), "{err}");
     let err = s.write_with("b.bin", |_| Ok(())).unwrap_err().to_string();
-    assert!(err.contains(&*dest.join("b.bin").to_string_lossy()), "{err}");
+    assert!(
+        err.contains(&*dest.join("b.bin").to_string_lossy()),
+        "{err}"
+    );
     for bad in ["", "..", ".", "x/y", "/abs", MANIFEST] {
         assert!(s.write_bytes(bad, b"1").is_err(), "{bad:?} accepted");
     }
@@ -136,11 +154,17 @@ fn what_killed_runs_left_is_restored_or_removed() {
     fs::write(staged.join("a.json"), b"new").unwrap();
     // Another folder's staging and a live run's staging are not ours to touch.
     let other = t.path().join(temp_name("other", "tmp", dead, 2));
-    let live = t.path().join(temp_name("out", "tmp", std::process::id(), 99));
+    let live = t
+        .path()
+        .join(temp_name("out", "tmp", std::process::id(), 99));
     fs::create_dir(&other).unwrap();
     fs::create_dir(&live).unwrap();
     recover(t.path(), "out", &dest);
-    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"old", "old set restored");
+    assert_eq!(
+        fs::read(dest.join("a.json")).unwrap(),
+        b"old",
+        "old set restored"
+    );
     assert!(!aside.exists() && !staged.exists());
     assert!(other.exists() && live.exists());
 
@@ -153,7 +177,10 @@ fn what_killed_runs_left_is_restored_or_removed() {
 
 #[test]
 fn temporary_names_parse() {
-    assert_eq!(parse_temp(".flux.exr.tmp-12-0"), Some(("flux.exr", "tmp", 12)));
+    assert_eq!(
+        parse_temp(".flux.exr.tmp-12-0"),
+        Some(("flux.exr", "tmp", 12))
+    );
     assert_eq!(parse_temp(".run.v2.old-7-3"), Some(("run.v2", "old", 7)));
     assert_eq!(parse_temp("flux.exr"), None);
     assert_eq!(parse_temp(".notes.tmp-x-1"), None);

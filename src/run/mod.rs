@@ -12,14 +12,14 @@
 //! standard error at or below `--target-error`, or `--max-time` seconds spent.
 //!
 //! Outputs written by [`RunResult::write`]:
-//! - `flux.exr`: channels `flux` (W/mm^2 per bin), `flux_stderr`, `hits`;
-//! - `angular.exr`: channels `intensity` (W/sr per (theta, phi) bin), `intensity_stderr`,
-//!   `hits`, and `luminance`, `luminance_stderr` (cd/m^2 averaged over the target) when
-//!   the sources give their lumens; x = phi, y = theta;
+//! - `flux.exr`, `angular.exr`: irradiance (W/mm^2 per bin) and radiant intensity (W/sr
+//!   per (theta, phi) bin) as grey images with their errors and hit counts as layers, and
+//!   the run's facts as header attributes (see the `images` module);
 //! - `flux.png`: false-colour preview of the flux map;
 //! - `convergence.csv`, `convergence.png`: metrics and errors against photons and time;
 //! - `summary.json`: run facts, energy ledger, uniformity and errors.
 
+mod images;
 pub mod metrics;
 pub mod summary;
 
@@ -422,37 +422,8 @@ impl RunResult<'_> {
     /// Write every output into `staged`, a folder of an output set.
     pub fn write_into(&self, staged: &SetDir) -> Result<()> {
         let flux = self.flux_map();
-        let d = &self.scene.detector;
-        let bin = d.bin_size();
-        let common = [
-            ("photons", self.tally.ledger.photons as f64),
-            ("seed", self.options.seed as f64),
-        ];
-        let flux_attrs = [
-            ("bin_size_x_mm", bin[0]),
-            ("bin_size_y_mm", bin[1]),
-            ("size_x_mm", d.size[0]),
-            ("size_y_mm", d.size[1]),
-            common[0],
-            common[1],
-        ];
-        write_map_exr(
-            staged,
-            "flux.exr",
-            &flux,
-            ["flux", "flux_stderr"],
-            &flux_attrs,
-        )?;
-        let ang = self.angular_map();
-        let [bin_theta, bin_phi] = d.angular_bin_deg();
-        let ang_attrs = [
-            ("bin_theta_deg", bin_theta),
-            ("bin_phi_deg", bin_phi),
-            common[0],
-            common[1],
-        ];
-        let lum = metrics::luminance_map(self.scene, &self.tally);
-        write_angular_exr(staged, &ang, lum.as_ref(), &ang_attrs)?;
+        images::write_flux_exr(self, staged, &flux)?;
+        images::write_angular_exr(self, staged)?;
         let d = &self.scene.detector;
         staged.write_with("flux.png", |png| {
             output::png::write_false_colour(
@@ -478,51 +449,4 @@ impl RunResult<'_> {
         staged.write_bytes("summary.json", &json)?;
         Ok(())
     }
-}
-
-/// angular.exr: intensity (W/sr), and luminance (cd/m^2) when the sources give lumens.
-fn write_angular_exr(
-    staged: &SetDir,
-    ang: &Map,
-    lum: Option<&Map>,
-    attrs: &[(&str, f64)],
-) -> Result<()> {
-    let f = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    let hits: Vec<f32> = ang.hits.iter().map(|&h| h as f32).collect();
-    let (i, ie) = (f(&ang.value), f(&ang.stderr));
-    let mut channels: Vec<(&str, &[f32])> = vec![
-        ("intensity", &i),
-        ("intensity_stderr", &ie),
-        ("hits", &hits),
-    ];
-    let (l, le) = lum.map_or((Vec::new(), Vec::new()), |m| (f(&m.value), f(&m.stderr)));
-    if lum.is_some() {
-        channels.extend([("luminance", &l[..]), ("luminance_stderr", &le[..])]);
-    }
-    staged.write_with("angular.exr", |path| {
-        output::exr::write_channels(path, ang.nx, ang.ny, &channels, attrs)
-    })?;
-    Ok(())
-}
-
-fn write_map_exr(
-    staged: &SetDir,
-    name: &str,
-    m: &Map,
-    names: [&str; 2],
-    attrs: &[(&str, f64)],
-) -> Result<()> {
-    let as_f32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    let (value, stderr) = (as_f32(&m.value), as_f32(&m.stderr));
-    let hits: Vec<f32> = m.hits.iter().map(|&h| h as f32).collect();
-    staged.write_with(name, |path| {
-        output::exr::write_channels(
-            path,
-            m.nx,
-            m.ny,
-            &[(names[0], &value), (names[1], &stderr), ("hits", &hits)],
-            attrs,
-        )
-    })?;
-    Ok(())
 }

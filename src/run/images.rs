@@ -1,0 +1,137 @@
+//! The run's EXR images, laid out as image tools read them.
+//!
+//! - `flux.exr`: channel `Y` = irradiance on the target plane (W/mm^2 per bin), so that any
+//!   viewer shows a grey image; layer `stderr` (`stderr.Y`) = its standard error (W/mm^2);
+//!   layer `hits` (`hits.Y`, 32-bit unsigned integers) = photons scored per bin. Grid x
+//!   along the detector's `u`, y along `v`, y up in the image.
+//! - `angular.exr`: `Y` = radiant intensity (W/sr per (theta, phi) bin), `stderr.Y`,
+//!   `hits.Y`, and when the sources give lumens `luminance.Y` and `luminance_stderr.Y`
+//!   (cd/m^2, averaged over the target); x = phi, y = theta.
+//!
+//! Header attributes of both: `software` (`blutrace VERSION`) and `comments` (what the
+//! channels hold; the standard EXR attributes, which tools carry into other formats),
+//! `units` (of `Y` and `stderr.Y`), `scene`, `scene_hash` (the content hash of
+//! `scene::hash`, as in shard files), `seed` and `photons` (text: exact for every `u64`),
+//! `detector_origin_mm`, `detector_u`, `detector_v` (`[x, y, z]`), the bin and target sizes
+//! (`bin_size_x_mm`, `bin_size_y_mm`, `size_x_mm`, `size_y_mm`) or the angular bin sizes
+//! (`bin_theta_deg`, `bin_phi_deg`). All are EXR `string`s holding numbers in Rust's
+//! shortest round-trip form: exact, and read by every tool (OpenEXR's Python module's old
+//! `InputFile` API returns `None` for `double` attributes).
+
+use super::RunResult;
+use super::metrics::{self, Map};
+use crate::output::atomic::SetDir;
+use crate::output::exr::{Attribute, Samples, write_channels};
+use anyhow::Result;
+use glam::DVec3;
+
+/// `flux.exr` of the map `flux`.
+pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Result<()> {
+    let d = &run.scene.detector;
+    let bin = d.bin_size();
+    let mut attrs = common_attributes(
+        run,
+        "W/mm^2",
+        "blutrace flux map: Y = irradiance on the target plane (W/mm^2 per bin), \
+         stderr.Y = its standard error (W/mm^2), hits.Y = photons per bin; \
+         x along detector_u, y along detector_v from detector_origin_mm",
+    );
+    for (name, v) in [
+        ("bin_size_x_mm", bin[0]),
+        ("bin_size_y_mm", bin[1]),
+        ("size_x_mm", d.size[0]),
+        ("size_y_mm", d.size[1]),
+    ] {
+        attrs.push((name, Attribute::Text(v.to_string())));
+    }
+    let (value, stderr, hits) = (f32s(&flux.value), f32s(&flux.stderr), counts(&flux.hits));
+    staged.write_with("flux.exr", |path| {
+        let channels = [
+            ("Y", Samples::F32(&value)),
+            ("stderr.Y", Samples::F32(&stderr)),
+            ("hits.Y", Samples::U32(&hits)),
+        ];
+        write_channels(path, flux.nx, flux.ny, &channels, &attrs)
+    })?;
+    Ok(())
+}
+
+/// `angular.exr`: intensity (W/sr), and luminance (cd/m^2) when the sources give lumens.
+pub(super) fn write_angular_exr(run: &RunResult, staged: &SetDir) -> Result<()> {
+    let ang = run.angular_map();
+    let lum = metrics::luminance_map(run.scene, &run.tally);
+    let mut comments = String::from(
+        "blutrace angular map: Y = radiant intensity (W/sr per bin), stderr.Y = its standard \
+         error, hits.Y = photons per bin",
+    );
+    if lum.is_some() {
+        comments += ", luminance.Y = luminance (cd/m^2, averaged over the target), \
+                     luminance_stderr.Y = its standard error";
+    }
+    comments += "; x = phi (0 to 360 deg), y = theta (0 to 90 deg from the target normal)";
+    let mut attrs = common_attributes(run, "W/sr", &comments);
+    let [bin_theta, bin_phi] = run.scene.detector.angular_bin_deg();
+    attrs.push(("bin_theta_deg", Attribute::Text(bin_theta.to_string())));
+    attrs.push(("bin_phi_deg", Attribute::Text(bin_phi.to_string())));
+    if lum.is_some() {
+        attrs.push(("luminance_units", Attribute::Text("cd/m^2".into())));
+    }
+    let (i, ie, hits) = (f32s(&ang.value), f32s(&ang.stderr), counts(&ang.hits));
+    let (l, le) = lum.as_ref().map_or((Vec::new(), Vec::new()), |m| {
+        (f32s(&m.value), f32s(&m.stderr))
+    });
+    let mut channels = vec![
+        ("Y", Samples::F32(&i)),
+        ("stderr.Y", Samples::F32(&ie)),
+        ("hits.Y", Samples::U32(&hits)),
+    ];
+    if lum.is_some() {
+        channels.push(("luminance.Y", Samples::F32(&l)));
+        channels.push(("luminance_stderr.Y", Samples::F32(&le)));
+    }
+    staged.write_with("angular.exr", |path| {
+        write_channels(path, ang.nx, ang.ny, &channels, &attrs)
+    })?;
+    Ok(())
+}
+
+/// The attributes both images carry.
+fn common_attributes(
+    run: &RunResult,
+    units: &str,
+    comments: &str,
+) -> Vec<(&'static str, Attribute)> {
+    let d = &run.scene.detector;
+    let text = |s: String| Attribute::Text(s);
+    let vec3 = |v: DVec3| text(format!("[{}, {}, {}]", v.x, v.y, v.z));
+    vec![
+        (
+            "software",
+            text(format!("blutrace {}", env!("CARGO_PKG_VERSION"))),
+        ),
+        ("comments", text(comments.to_owned())),
+        ("units", text(units.to_owned())),
+        ("scene", text(run.scene.name.clone())),
+        (
+            "scene_hash",
+            text(format!("{:016x}", run.scene.content_hash())),
+        ),
+        ("seed", text(run.options.seed.to_string())),
+        ("photons", text(run.tally.ledger.photons.to_string())),
+        ("detector_origin_mm", vec3(d.origin)),
+        ("detector_u", vec3(d.u)),
+        ("detector_v", vec3(d.v)),
+    ]
+}
+
+fn f32s(v: &[f64]) -> Vec<f32> {
+    v.iter().map(|&x| x as f32).collect()
+}
+
+/// Hit counts as EXR `uint`; a bin beyond 2^32 - 1 photons (never met in practice: 4e9
+/// photons in one bin) saturates.
+fn counts(v: &[u64]) -> Vec<u32> {
+    v.iter()
+        .map(|&h| u32::try_from(h).unwrap_or(u32::MAX))
+        .collect()
+}

@@ -271,8 +271,17 @@ pub fn convergence_csv(history: &[ConvergenceRow]) -> String {
     s
 }
 
-/// Relative error against run time on log-log axes, with the 1/sqrt(t) reference line.
+/// Relative error against run time, with the 1/sqrt(t) reference line; see
+/// [`convergence_chart`].
 pub fn write_convergence_png(path: &Path, history: &[ConvergenceRow]) -> Result<()> {
+    write_chart(path, &convergence_chart(history))
+}
+
+/// The chart of `convergence.png`: relative standard errors against tracing time and the
+/// 1/sqrt(t) line through the first round's error of the mean flux, over the rounds' time
+/// span only. Each axis is logarithmic when its data span at least a decade, else linear
+/// (two rounds of a short run span a factor of two, which a log axis would pad to decades).
+pub fn convergence_chart(history: &[ConvergenceRow]) -> Chart {
     let shown = [
         (Metric::Mean, "mean flux"),
         (Metric::Efficiency, "efficiency"),
@@ -292,31 +301,111 @@ pub fn write_convergence_png(path: &Path, history: &[ConvergenceRow]) -> Result<
             markers: true,
         })
         .collect();
+    let x_scale = scale_for(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let y_scale = scale_for(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     let mean = Metric::Mean;
-    if let Some(first) = history
+    let first = history
         .iter()
-        .find(|r| r.seconds > 0.0 && r.stderr[mean] > 0.0)
-    {
+        .find(|r| r.seconds > 0.0 && r.stderr[mean] > 0.0);
+    let t_end = history.last().map_or(0.0, |r| r.seconds);
+    if let Some(first) = first.filter(|f| t_end > f.seconds) {
         let e0 = first.stderr[mean] / first.values[mean];
-        let t_end = history
-            .last()
-            .map_or(first.seconds, |r| r.seconds)
-            .max(first.seconds * 10.0);
-        let reference = [first.seconds, t_end].map(|t| (t, e0 * (first.seconds / t).sqrt()));
+        // Enough points to draw the curve on linear axes too.
+        let n = 32;
+        let points = (0..=n)
+            .map(|k| {
+                let t = first.seconds * (t_end / first.seconds).powf(k as f64 / n as f64);
+                (t, e0 * (first.seconds / t).sqrt())
+            })
+            .collect();
         series.push(Series {
             label: "1/sqrt(t)".into(),
-            points: reference.to_vec(),
+            points,
             dashed: true,
             markers: false,
         });
     }
-    let chart = Chart {
+    Chart {
         title: "Monte Carlo error against run time".into(),
         x_label: "tracing time (s)".into(),
         y_label: "relative standard error".into(),
-        x_scale: Scale::Log10,
-        y_scale: Scale::Log10,
+        x_scale,
+        y_scale,
         series,
-    };
-    write_chart(path, &chart)
+    }
+}
+
+/// Log10 when the positive finite `values` span at least a factor of ten, else linear.
+fn scale_for(values: impl Iterator<Item = f64>) -> Scale {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if hi >= 10.0 * lo {
+        Scale::Log10
+    } else {
+        Scale::Linear
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn history(seconds: &[f64]) -> Vec<ConvergenceRow> {
+        seconds
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| {
+                let n = (k + 1) as f64;
+                ConvergenceRow {
+                    photons: 4096 * (k as u64 + 1),
+                    seconds: t,
+                    values: MetricValues::splat(1.0),
+                    stderr: MetricValues::splat(0.01 / n.sqrt()),
+                }
+            })
+            .collect()
+    }
+
+    fn time_range(chart: &Chart) -> (f64, f64) {
+        let t = chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.0));
+        t.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
+    }
+
+    #[test]
+    fn two_rounds_of_a_short_run_get_linear_axes_over_the_run() {
+        let chart = convergence_chart(&history(&[1.5, 2.0]));
+        assert_eq!(chart.x_scale, Scale::Linear);
+        // The errors (0.007 to 1 here: the bins' error is a relative error itself) do
+        // span decades.
+        assert_eq!(chart.y_scale, Scale::Log10);
+        let (lo, hi) = time_range(&chart);
+        assert_eq!(
+            (lo, hi),
+            (1.5, 2.0),
+            "the reference line stays within the run"
+        );
+        let reference = chart.series.last().unwrap();
+        assert_eq!(reference.label, "1/sqrt(t)");
+        let (t, e) = reference.points[reference.points.len() - 1];
+        assert!((e - 0.01 * (1.5f64 / t).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn runs_over_decades_get_log_axes_spanning_the_data() {
+        let times: Vec<f64> = (0..12).map(|k| 0.1 * 2f64.powi(k)).collect();
+        let chart = convergence_chart(&history(&times));
+        assert_eq!(chart.x_scale, Scale::Log10);
+        let (lo, hi) = time_range(&chart);
+        assert_eq!((lo, hi), (0.1, times[11]));
+        // One round: no reference line, nothing beyond the data.
+        let chart = convergence_chart(&history(&[2.0]));
+        assert_eq!(chart.series.len(), 5);
+        assert_eq!(time_range(&chart), (2.0, 2.0));
+    }
 }

@@ -28,8 +28,10 @@ pub(super) struct Tick {
 impl Axis {
     /// The axis covering data from `min` to `max` (in axis units, finite, `min <= max`)
     /// with a margin of 5 % of the span on both sides. A zero (or negligible) span gets
-    /// ±10 % of the value (±1 around zero) on a linear axis and ±½ decade on a log axis;
-    /// a log axis is widened to whole decades if it would show fewer than two powers of ten.
+    /// ±10 % of the value (±1 around zero) on a linear axis and ±½ decade on a log axis.
+    /// A log axis over data spanning less than a decade is widened to whole decades if it
+    /// would show fewer than two powers of ten; data spanning a decade or more keep their
+    /// own range, which always holds labelled ticks at 1, 2 or 5 times powers of ten.
     pub(super) fn fit(scale: Scale, min: f64, max: f64) -> Result<Self> {
         let span = max - min;
         let (lo, hi) = match scale {
@@ -54,7 +56,7 @@ impl Axis {
                 } else {
                     (min - 0.05 * span, max + 0.05 * span)
                 };
-                if hi.floor() - lo.ceil() < 1.0 {
+                if span < 1.0 && hi.floor() - lo.ceil() < 1.0 {
                     (lo.floor(), hi.ceil())
                 } else {
                     (lo, hi)

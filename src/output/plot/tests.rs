@@ -292,6 +292,10 @@ fn ranges_of_degenerate_data() {
     );
     let a = fit(Scale::Log10, 0.012f64.log10(), 0.03f64.log10());
     assert_eq!((a.lo, a.hi), (-2.0, -1.0));
+    // Data over a decade keep their range: 1.5 s to 16 s is not padded to 1 s to 100 s.
+    let a = fit(Scale::Log10, 1.5f64.log10(), 16f64.log10());
+    assert!(a.lo > 1.2f64.log10() && a.hi < 20f64.log10(), "{a:?}");
+    assert!(a.log_ticks(8).iter().filter(|t| t.label.is_some()).count() >= 2);
     let a = fit(Scale::Log10, -300.0, 300.0);
     assert!(a.lo < -300.0 && a.hi > 300.0);
 }

@@ -194,6 +194,55 @@ fn garbage_toml_names_the_file() {
     assert_mentions(&msg, &["scene.toml"]);
 }
 
+/// Load `toml` with the plate geometry: `Ok` or the error message.
+fn load_plate(name: &str, toml: &str) -> Result<(), String> {
+    let obj = plate();
+    let path = write_scene(name, toml, &[("plate.obj", &obj)]);
+    Scene::load(&path).map(|_| ()).map_err(|e| format!("{e:#}"))
+}
+
+#[test]
+fn lattice_pitch_is_bounded_by_the_face() {
+    // The dotted face (z = -0.5, 20 x 20 mm) reaches sqrt(20^2 + 10^2) = 22.36 mm from the
+    // pattern's origin (-10, 0, -0.5): the pitch must be within [2.236e-5, 2.236e7] mm.
+    let grooves = GOOD.replace(
+        "model = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"square\"",
+        "model = \"grooves\"\ninside = \"pmma\"\nrelief = \"cut\"\napex_deg = 110.0",
+    );
+    let grooves = grooves.replace("length_mm = 20.0\ndensity = [0.2]\n", "");
+    assert_ne!(grooves, GOOD);
+    for (model, toml) in [("dots", GOOD), ("grooves", grooves.as_str())] {
+        for (pitch, ok) in [
+            ("1e-300", false),
+            ("2.2e-5", false),
+            ("2.3e-5", true),
+            ("0.5", true),
+            ("2.2e7", true),
+            ("2.3e7", false),
+            ("1e300", false),
+        ] {
+            let name = format!("pitch-{model}-{pitch}");
+            let got = load_plate(
+                &name,
+                &toml.replace("pitch_mm = 0.5", &format!("pitch_mm = {pitch}")),
+            );
+            match (ok, got) {
+                (true, Ok(())) => {}
+                (false, Err(msg)) => assert_mentions(
+                    &msg,
+                    &[
+                        "scene.toml",
+                        "surfaces.dots.pitch_mm",
+                        "22.36",
+                        "representable",
+                    ],
+                ),
+                (ok, got) => panic!("{model} pitch {pitch}: expected ok = {ok}, got {got:?}"),
+            }
+        }
+    }
+}
+
 #[test]
 fn numbers_are_bounded() {
     let two_sources = GOOD.replace("power_w = 1.0", "power_w = 1.7e308")

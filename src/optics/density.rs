@@ -15,11 +15,37 @@
 //! ```
 //!
 //! Dots and grooves measure `x` with the same [`graded_x`] and check the range of their
-//! value with the same [`Gradation::first_outside`].
+//! value with the same [`Gradation::first_outside`], and their pitch with the same
+//! [`check_pitch`].
 
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
+
+/// The pitch of a dot or groove lattice, relative to the face's reach (the farthest vertex
+/// of the face from the pattern's origin), is kept within `[1e-6, 1e6]`: positions on the
+/// face are then resolved to 2e-10 of a cell or better (f64 carries 16 digits), and the
+/// cell index of any point stays a small integer. Finer lattices are not representable
+/// (at `pitch_mm = 1e-300` dots vanish and grooves fall back to the smooth plane, slowly),
+/// and are sub-wavelength long before that, where ray optics does not hold anyway.
+pub const PITCH_RANGE: [f64; 2] = [1e-6, 1e6];
+
+/// Check the lattice `pitch` (mm) against the face's `reach` (mm), see [`PITCH_RANGE`].
+pub fn check_pitch(ctx: &Ctx, field: &str, pitch: f64, reach: f64) -> Result<()> {
+    let [lo, hi] = PITCH_RANGE.map(|k| k * reach);
+    if pitch < lo || pitch > hi {
+        return Err(ctx.err(
+            field,
+            format!(
+                "{pitch:e} mm is out of range for a face reaching {reach:.4} mm from the pattern's origin: \
+                 the pitch must be within [{lo:.3e}, {hi:.3e}] mm ({:e} to {:e} times the reach) for the \
+                 lattice to be representable",
+                PITCH_RANGE[0], PITCH_RANGE[1]
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// How the polynomial's variable is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]

@@ -19,6 +19,7 @@ mod solids;
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh, spawn_epsilon};
+use crate::optics::density::check_pitch;
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
 use crate::sources::Sources;
@@ -453,17 +454,31 @@ fn fit_patterns_to_faces(
             .filter(move |(_, t)| **t as usize == tag_id)
             .map(|(p, _)| mesh.normal(p as u32))
     };
+    // The farthest vertex of the tag's faces from `origin`.
+    let reach = |tag_id: usize, origin: DVec3| {
+        mesh.triangles
+            .iter()
+            .zip(&mesh.tri_tag)
+            .filter(|(_, t)| **t as usize == tag_id)
+            .flat_map(|(tri, _)| tri.map(|v| mesh.positions[v as usize].distance(origin)))
+            .fold(0.0, f64::max)
+    };
+    let pitch_field = |tag_id: usize| format!("surfaces.{}.pitch_mm", tags[tag_id]);
     // All dots first, then all grooves: which error comes first does not depend on the
     // order of the tags.
     for (tag_id, s) in surfaces.iter_mut().enumerate() {
         if let SurfaceModel::Dots { pattern, .. } = s {
             let n = normals(tag_id).next().expect("used tag has triangles");
             pattern.fit_to_face(ctx, &tags[tag_id], n)?;
+            let r = reach(tag_id, pattern.origin);
+            check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
         }
     }
     for (tag_id, s) in surfaces.iter_mut().enumerate() {
         if let SurfaceModel::Grooves { pattern, .. } = s {
             pattern.fit_to_face(ctx, &tags[tag_id], normals(tag_id))?;
+            let r = reach(tag_id, pattern.origin);
+            check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
         }
     }
     Ok(())

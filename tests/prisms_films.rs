@@ -491,3 +491,29 @@ fn diffuser_faces_spread_light_and_lose_none() {
         first_row(&tb)
     );
 }
+
+/// The relief is self-similar: at the finest pitch the scene bounds allow (1e-6 of the
+/// face's reach, `optics::density::PITCH_RANGE`), a million grooves across the plate give
+/// the same fates as 80, within 4 standard errors: the bound keeps the lattice
+/// representable (at 1e-300 mm it was not, and the grooves extracted nothing).
+#[test]
+fn grooves_at_the_finest_allowed_pitch_trace_like_coarse_ones() {
+    let path = bundled("test/prism-plate");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let obj = std::fs::read_to_string(path.with_file_name("prism-plate.obj")).unwrap();
+    // The back face reaches 21.54 mm from the origin: the bound is 2.154e-5 mm.
+    let fine = text.replace("pitch_mm = 0.25", "pitch_mm = 2.2e-5");
+    assert_ne!(fine, text);
+    let dir = write_scene("fine-grooves", &fine, &[("prism-plate.obj", &obj)]);
+    let (coarse, fine) = (load_bundled("test/prism-plate"), load(&dir));
+    let n = photons(200_000);
+    let (a, b) = (trace(&coarse, n, 7, 2), trace(&fine, n, 8, 2));
+    for ((name, p), (_, q)) in fates(&a).into_iter().zip(fates(&b)) {
+        let sigma = ((p * (1.0 - p) + q * (1.0 - q)) / n as f64).sqrt();
+        assert!(
+            (p - q).abs() <= 4.0 * sigma + 1e-12,
+            "{name}: pitch 0.25 mm {p:.5}, 2.2e-5 mm {q:.5} (sigma {sigma:.1e})"
+        );
+    }
+    assert!(fates(&b)[0].1 > 0.05, "light is detected: {:?}", fates(&b));
+}

@@ -3,8 +3,9 @@
 //! - [`atomic`]: [`atomic::OutputSet`] writes every output file of a run into a staging
 //!   folder that replaces the output folder in one step once the whole set is written, so
 //!   the folder always holds one complete set (the previous or the new one).
-//! - [`exr`]: multi-channel 32-bit float OpenEXR images (lossless ZIP compression) with
-//!   numeric header attributes, plus a reader for the files it writes.
+//! - [`exr`]: multi-channel OpenEXR images (32-bit float or unsigned integer channels,
+//!   lossless ZIP compression) with text and number header attributes, plus a reader for
+//!   the files it writes.
 //! - [`png`]: false-colour previews (viridis colour map with a colour bar) for people.
 //! - [`colormap`]: the viridis colour map; `font`: the 5×7 pixel font of previews and charts.
 //! - [`plot`]: line charts (convergence, optimizer histories).

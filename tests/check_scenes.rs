@@ -45,3 +45,26 @@ fn check_passes_on_every_bundled_scene() {
         }
     }
 }
+
+#[test]
+fn a_reader_that_stops_early_ends_check_quietly() {
+    use std::process::Stdio;
+    let scene = &support::bundled_scene_files()[0];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .arg("check")
+        .arg(scene)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run blutrace");
+    // Close the reading end before check has printed anything (it loads the scene first).
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        out.status.success() || out.status.code() == Some(141),
+        "{:?}: {stderr}",
+        out.status
+    );
+}

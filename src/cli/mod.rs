@@ -57,6 +57,7 @@ enum Command {
 
 /// Parse the command line, run it, and report an error on stderr.
 pub fn main() -> ExitCode {
+    quiet_on_broken_pipe();
     match Cli::parse().command.execute() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -64,6 +65,26 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// A reader that closes our stdout early (`blutrace check SCENE | head`) ends the
+/// program quietly, as it does other Unix tools, instead of with a panic message: Rust
+/// ignores SIGPIPE, so `println!` panics on the broken pipe. Exit status 141 (128 +
+/// SIGPIPE) is what a shell reports for a writer killed that way.
+fn quiet_on_broken_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let msg = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info)
+    }));
 }
 
 impl Command {

@@ -24,7 +24,9 @@ use std::path::{Path, PathBuf};
 /// File name of a shard's raw tallies inside its output folder.
 pub const SHARD_FILE: &str = "shard.json";
 const FORMAT: &str = "blutrace-shard";
-const FORMAT_VERSION: u32 = 1;
+/// 2: the ledger books lamp bodies (`absorbed_by_source`) and counts hits per tag
+/// (`hits_by_tag`, `feature_hits_by_tag`).
+const FORMAT_VERSION: u32 = 2;
 
 /// A shard's raw tallies and what identifies the run it belongs to.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -235,6 +235,12 @@ pub struct Ledger {
     pub photons: u64,
     /// Surface interactions (roulette events).
     pub interactions: u64,
+    /// Surface interactions per tag (they add up to `interactions` less the hits on lamp
+    /// bodies).
+    pub hits_by_tag: Vec<u64>,
+    /// Of those, the ones that met the tag's pattern: ink on a dots face, a groove facet
+    /// on a grooves face (zero for other models).
+    pub feature_hits_by_tag: Vec<u64>,
     /// Emitted weight.
     pub emitted: ExactSum,
     /// Weight detected on the target (sum and sum of squares per photon).
@@ -259,6 +265,8 @@ pub struct Ledger {
 impl Ledger {
     pub(crate) fn new(tags: usize, media: usize, sources: usize) -> Self {
         Self {
+            hits_by_tag: vec![0; tags],
+            feature_hits_by_tag: vec![0; tags],
             absorbed_by_surface: vec![ExactSum::default(); tags],
             absorbed_in_medium: vec![ExactSum::default(); media],
             absorbed_by_source: vec![ExactSum::default(); sources],
@@ -281,6 +289,14 @@ impl Ledger {
         }
     }
 
+    /// Count one surface interaction on tag `tag`, which met the tag's pattern (ink, a
+    /// groove) when `feature`.
+    pub(crate) fn hit(&mut self, tag: u32, feature: bool) {
+        self.interactions += 1;
+        self.hits_by_tag[tag as usize] += 1;
+        self.feature_hits_by_tag[tag as usize] += u64::from(feature);
+    }
+
     /// Book the weight lost between `before` and `after` at `sink`.
     pub(crate) fn lose(sink: &mut ExactSum, before: f64, after: f64) {
         sink.add(before);
@@ -295,6 +311,14 @@ impl Ledger {
     pub(crate) fn merge_signed(&mut self, o: &Ledger, sign: Sign) {
         sign.apply_u64(&mut self.photons, o.photons);
         sign.apply_u64(&mut self.interactions, o.interactions);
+        for (mine, theirs) in [
+            (&mut self.hits_by_tag, &o.hits_by_tag),
+            (&mut self.feature_hits_by_tag, &o.feature_hits_by_tag),
+        ] {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                sign.apply_u64(a, *b);
+            }
+        }
         self.emitted.merge_signed(o.emitted, sign);
         self.detected.merge_signed(&o.detected, sign);
         for (mine, theirs) in [

@@ -16,7 +16,7 @@
 
 use crate::accel::Accel;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
-use crate::optics::surface::{Estimator, MediumId, Outcome, SurfaceModel};
+use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
@@ -90,16 +90,17 @@ impl Tracer<'_> {
             let Some(Hit { surf, struck }) = surf else {
                 return Fate::Escaped;
             };
-            out.ledger.interactions += 1;
             let model = self.model(struck);
-            match model.interact(
+            let (outcome, feature) = model.interact_on(
                 &scene.media,
                 &surf,
                 true_ray.dir,
                 p.medium,
                 self.estimator,
                 rng,
-            ) {
+            );
+            struck.count(&mut out.ledger, feature);
+            match outcome {
                 Outcome::Absorbed => return struck.absorbed(),
                 Outcome::Scattered {
                     dir,
@@ -292,6 +293,15 @@ impl Struck {
         match self {
             Struck::Surface(tag) => Fate::AbsorbedBySurface(tag),
             Struck::Body(i) | Struck::BodyBack(i) => Fate::AbsorbedBySource(i),
+        }
+    }
+
+    /// Count the interaction: per tag (and whether it met the tag's pattern) on a surface,
+    /// only in the total on a lamp body.
+    fn count(self, ledger: &mut Ledger, feature: Feature) {
+        match self {
+            Struck::Surface(tag) => ledger.hit(tag, feature != Feature::Plain),
+            Struck::Body(_) | Struck::BodyBack(_) => ledger.interactions += 1,
         }
     }
 

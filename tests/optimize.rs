@@ -4,7 +4,7 @@
 
 mod support;
 
-use blutrace::optics::dots::{Density, DensityGrid, DotPattern, Lattice, XUnit};
+use blutrace::optics::dots::{Density, DensityGrid, DotPattern, Lattice, Placement, XUnit};
 use blutrace::optimize::export::{self, Dot};
 use blutrace::optimize::nelder_mead::{self, Settings, Termination};
 use blutrace::optimize::{Method, OptimizeOptions, optimize};
@@ -153,6 +153,8 @@ fn pattern(lattice: Lattice, density: Density) -> DotPattern {
         density,
         x_unit: XUnit::Normalized,
         mirror: false,
+        placement: Placement::Lattice,
+        placement_seed: 0,
     }
 }
 
@@ -191,7 +193,7 @@ fn exported_dots_round_trip_to_the_density() {
     // quarter pitch in, so every row (shifted or not) has exactly 6 dots in each.
     for (lattice, offset, strip) in [(Lattice::Square, 0.0, 0.5), (Lattice::Hex, 0.125, 3.0)] {
         let p = pattern(lattice, density.clone());
-        let dots = export::dots_on_face(&p, &rectangle());
+        let dots = export::dots_on_face(&p, &rectangle()).unwrap();
         assert!(
             dots.iter()
                 .all(|d| (0.0..=30.0).contains(&d.x) && (0.0..=12.0).contains(&d.y))
@@ -220,7 +222,7 @@ fn exported_dots_round_trip_to_the_density() {
         Lattice::Square,
         Density::Table(vec![[0.0, 0.1], [1.0, 0.5]]),
     );
-    let dots = export::dots_on_face(&p, &rectangle());
+    let dots = export::dots_on_face(&p, &rectangle()).unwrap();
     let got = area_fraction_per_strip(&dots, 0.0, 0.5, 60, 12.0);
     for (k, g) in got.iter().enumerate() {
         let want = p.density_at((k as f64 + 0.5) * 0.5);
@@ -258,7 +260,7 @@ fn density_grid_is_bilinear_at_cell_centres_and_covers_its_area_fraction() {
     assert_eq!(p.density.problem(), None);
     assert_eq!(p.first_out_of_range(), None);
     // Every exported dot is sized by the bilinear density at its own cell centre.
-    let dots = export::dots_on_face(&p, &rectangle());
+    let dots = export::dots_on_face(&p, &rectangle()).unwrap();
     assert!(dots.len() > 1000);
     for d in &dots {
         let want = grid_by_hand(d.x, d.y);
@@ -318,7 +320,7 @@ fn density_grid_is_bilinear_at_cell_centres_and_covers_its_area_fraction() {
 #[test]
 fn svg_and_dxf_hold_every_dot() {
     let p = pattern(Lattice::Hex, Density::Polynomial(vec![0.2]));
-    let dots = export::dots_on_face(&p, &rectangle());
+    let dots = export::dots_on_face(&p, &rectangle()).unwrap();
     let frame = export::SheetFrame::of_face(&p, &rectangle(), DVec3::ZERO);
     let svg = export::to_svg(&dots, &frame);
     assert_eq!(svg.matches("<circle ").count(), dots.len());
@@ -350,7 +352,7 @@ fn exports_use_the_sheet_frame_with_positive_coordinates() {
         .iter()
         .map(|t| t.map(|v| v - DVec3::new(0.0, 12.0, 0.0)))
         .collect();
-    let dots = export::dots_on_face(&p, &below);
+    let dots = export::dots_on_face(&p, &below).unwrap();
     assert!(dots.iter().all(|d| d.y < 0.0));
     let offset = DVec3::new(100.0, 0.0, 0.0);
     let frame = export::SheetFrame::of_face(&p, &below, offset);
@@ -583,7 +585,8 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
         // The density stays printable.
         let min = opts.min_density - 1e-12;
         let max = Lattice::Square.max_packing() + 1e-12;
-        assert!(r.dots.iter().all(|d| {
+        let dots = r.dots.as_ref().expect("a lattice pattern is printable");
+        assert!(dots.iter().all(|d| {
             let frac = PI * d.diameter * d.diameter / 4.0 / 0.25;
             frac >= min * 0.999 && frac <= max
         }));
@@ -626,7 +629,7 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
         let d = dots_of(&again);
         assert_eq!(d.density, r.final_density);
         let csv = std::fs::read_to_string(out.join("dots.csv")).unwrap();
-        assert_eq!(export::parse_csv(&csv).unwrap().len(), r.dots.len());
+        assert_eq!(export::parse_csv(&csv).unwrap().len(), dots.len());
     }
 }
 

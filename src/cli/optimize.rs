@@ -147,7 +147,26 @@ pub fn print_report(r: &OptimizeResult) {
             println!("density    grid of {nx} x {ny} knots (along x across)");
         }
     }
-    println!("dots       {} on {}", r.dots.len(), r.tag);
+    match (&r.dots, r.dots_placement) {
+        (Some(dots), Some(p)) if p == r.pattern.placement => {
+            println!(
+                "dots       {} on {} ({} placement)",
+                dots.len(),
+                r.tag,
+                p.name()
+            )
+        }
+        (Some(dots), Some(p)) => println!(
+            "dots       {} on {}: the traced placement \"virtual\" is not printable; the dot files hold a {} placement of the same density",
+            dots.len(),
+            r.tag,
+            p.name()
+        ),
+        _ => println!(
+            "dots       none written: surfaces.{} has placement \"virtual\", which is not printable; --export-placement stochastic (or jittered, lattice) writes a printable sheet of the same density",
+            r.tag
+        ),
+    }
     if let Some(v) = &r.verification {
         println!(
             "verify     re-traced with seed {} and {} photons:",

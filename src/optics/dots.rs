@@ -17,6 +17,8 @@
 //! density = [0.05, 0.0, 0.0, 0.0]  # d(x) = c0 + c1 x + c2 x^2 + c3 x^3
 //! x_unit = "normalized"      # x in [0, 1] ("mm": x in millimetres)
 //! mirror = true              # lamps on both edges: x measured from the nearer edge
+//! placement = "lattice"      # or "jittered", "stochastic", "virtual" (see dot_placement)
+//! placement_seed = 0         # jittered, stochastic: which random screen
 //! ```
 //!
 //! Instead of `density`, a tabulated density (what `blutrace optimize --method feedback`
@@ -40,10 +42,12 @@
 //! ```
 //!
 //! The density functions and their checks live in [`super::density`], shared with the
-//! groove fill of [`super::grooves`]; this module owns the lattice and the dots.
+//! groove fill of [`super::grooves`]; this module owns the lattice and the dot sizes,
+//! [`super::dot_placement`] where the dots sit and whether a hit meets ink.
 
 pub use super::density::{Density, DensityGrid, XUnit};
 use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};
+pub use super::dot_placement::{PlacedDot, Placement};
 use super::medium::{Interface, Medium, air};
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -90,6 +94,12 @@ pub struct DotsSpec {
     /// Lamps on both edges: measure from the nearer.
     #[serde(default)]
     pub mirror: bool,
+    /// Where the dots sit: "lattice" (default), "jittered", "stochastic", "virtual".
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<String>,
+    /// Which random screen (jittered, stochastic); 0 when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement_seed: Option<i64>,
 }
 
 /// A checked dots surface: the interface outside the dots, the dot layout (its `across`
@@ -123,7 +133,10 @@ impl DotsSpec {
         };
         let density = density.checked(ctx, &field)?;
         let lattice = self.lattice;
+        let placement = Placement::parse(ctx, &f("placement"), self.placement.as_deref())?;
         let pattern = DotPattern {
+            placement,
+            placement_seed: placement.seed(ctx, &f("placement_seed"), self.placement_seed)?,
             lattice,
             pitch: ctx.positive(&f("pitch_mm"), self.pitch_mm)?,
             origin: ctx.point(&f("origin"), self.origin)?,
@@ -205,6 +218,10 @@ pub struct DotPattern {
     pub x_unit: XUnit,
     /// Measure from the nearer of the two edges (lamps on both ends).
     pub mirror: bool,
+    /// Where the dots sit (see [`super::dot_placement`]).
+    pub placement: Placement,
+    /// Which random screen (jittered, stochastic placements).
+    pub placement_seed: u64,
 }
 
 impl DotPattern {
@@ -305,38 +322,10 @@ impl DotPattern {
     }
 
     /// The lattice point nearest to `q` (lattice coordinates).
+    #[cfg(test)]
     fn nearest_centre(&self, q: DVec2) -> DVec2 {
-        let p = self.pitch;
-        match self.lattice {
-            Lattice::Square => ((q / p).floor() + 0.5) * p,
-            Lattice::Hex => {
-                let h = 0.5 * 3f64.sqrt() * p;
-                let j0 = (q.y / h - 0.5).floor();
-                [j0, j0 + 1.0]
-                    .map(|j| {
-                        let shift = if (j as i64).rem_euclid(2) == 1 {
-                            0.5 * p
-                        } else {
-                            0.0
-                        };
-                        let i = ((q.x - shift) / p - 0.5).round();
-                        DVec2::new((i + 0.5) * p + shift, (j + 0.5) * h)
-                    })
-                    .into_iter()
-                    .min_by(|a, b| a.distance_squared(q).total_cmp(&b.distance_squared(q)))
-                    .expect("two candidates")
-            }
-        }
-    }
-
-    /// True when the face point `p` lies inside a printed dot.
-    pub fn covers(&self, p: DVec3) -> bool {
-        let q = self.face_coords(p);
-        let c = self.nearest_centre(q);
-        let r = self
-            .lattice
-            .dot_radius(self.pitch, self.density_at_point(c));
-        q.distance_squared(c) < r * r
+        let (i, j) = self.nearest_cell(q);
+        self.cell_centre(i, j)
     }
 }
 
@@ -355,6 +344,8 @@ mod tests {
             density: Density::Polynomial(vec![density]),
             x_unit: XUnit::Normalized,
             mirror: false,
+            placement: Placement::Lattice,
+            placement_seed: 0,
         }
     }
 
@@ -455,6 +446,8 @@ mod tests {
                 density,
                 x_unit,
                 mirror,
+                placement: Placement::Lattice,
+                placement_seed: 0,
             };
             for k in -3..=40 {
                 let u = k as f64;

@@ -1,7 +1,8 @@
 //! Optical models: what happens to a photon where it meets a surface.
 //!
 //! One module per surface model, each with its scene-file entry, its checks and its
-//! physics: [`dielectric`] (smooth interfaces), [`dots`] (procedural ink-dot patterns),
+//! physics: [`dielectric`] (smooth interfaces), [`dots`] (procedural ink-dot patterns,
+//! placed as [`dot_placement`] says),
 //! [`grooves`] (procedural V-grooves and prism films, traced exactly in their layer),
 //! [`diffuser`] (rough diffusing faces), [`phong`], [`lambert`], [`mirror`] and
 //! [`absorber`]; [`surface`] joins them into the per-tag model and its Russian roulette.
@@ -13,6 +14,7 @@ pub mod absorber;
 pub mod density;
 pub mod dielectric;
 pub mod diffuser;
+pub mod dot_placement;
 pub mod dots;
 pub mod fresnel;
 pub mod grooves;

@@ -86,6 +86,17 @@ pub enum Outcome {
     Absorbed,
 }
 
+/// What part of a patterned face a hit met (see [`SurfaceModel::interact_on`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Feature {
+    /// The plain surface (every unpatterned model, and dotted faces between dots).
+    Plain,
+    /// Ink of a dots pattern.
+    Ink,
+    /// A groove (or prism) of a grooves pattern.
+    Groove,
+}
+
 impl SurfaceModel {
     /// Roulette the fate of a photon arriving along `dir` in `medium` at `hit`.
     pub fn interact(
@@ -97,6 +108,20 @@ impl SurfaceModel {
         est: Estimator,
         rng: &mut PhotonRng,
     ) -> Outcome {
+        self.interact_on(media, hit, dir, medium, est, rng).0
+    }
+
+    /// [`SurfaceModel::interact`], also saying what part of a patterned face the photon
+    /// met (ink, a groove, or the plain surface), for the per-tag hit counts.
+    pub fn interact_on(
+        &self,
+        media: &[Medium],
+        hit: &SurfaceHit,
+        dir: DVec3,
+        medium: MediumId,
+        est: Estimator,
+        rng: &mut PhotonRng,
+    ) -> (Outcome, Feature) {
         // Normal on the side the photon came from.
         let facing = if dir.dot(hit.normal) < 0.0 {
             hit.normal
@@ -133,22 +158,24 @@ impl SurfaceModel {
             }
         };
         let indices = |i: &Interface| (media[i.inside as usize].n, media[i.outside as usize].n);
-        match self {
+        let plain = match self {
             SurfaceModel::Dielectric(i) => smooth(i, rng),
             SurfaceModel::Dots {
                 interface,
                 pattern,
                 ink_albedo,
             } => {
-                if pattern.covers(hit.point) {
-                    reflect(*ink_albedo, rng, &lambert)
-                } else {
-                    smooth(interface, rng)
+                if pattern.meets_ink(hit.point, rng) {
+                    return (reflect(*ink_albedo, rng, &lambert), Feature::Ink);
                 }
+                smooth(interface, rng)
             }
             SurfaceModel::Grooves { interface, pattern } => {
-                match pattern.scatter(indices(interface), hit.point, hit.normal, dir, rng) {
-                    Some(out) => lossless(interface, out),
+                match pattern.scatter_met(indices(interface), hit.point, hit.normal, dir, rng) {
+                    Some((d, inside, met)) => {
+                        let feature = if met { Feature::Groove } else { Feature::Plain };
+                        return (lossless(interface, (d, inside)), feature);
+                    }
                     None => smooth(interface, rng),
                 }
             }
@@ -167,7 +194,8 @@ impl SurfaceModel {
                 reflect(*reflectance, rng, &|_| Some(mirror::direction(dir, facing)))
             }
             SurfaceModel::Absorber => Outcome::Absorbed,
-        }
+        };
+        (plain, Feature::Plain)
     }
 
     /// Short model name for reports.

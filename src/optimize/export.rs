@@ -18,9 +18,13 @@
 //! axis = [1.0, 0.0, 0.0]     # dots.csv x
 //! ```
 //!
-//! A dot is listed when its centre lies on the face (inside one of the tag's triangles);
-//! its diameter is `2 sqrt(d(x) A / pi)` with `A` the cell area, so the dots cover the
-//! fraction `d(x)` of the face around `x`. The DXF is plain R12 ASCII: one `CIRCLE`
+//! The files list the dots the tracer sees, placed as the surface's `placement` says
+//! (lattice, jittered or stochastic, see [`crate::optics::dot_placement`]); `virtual`
+//! prints nothing and is refused. A dot is listed when its centre lies on the face (inside
+//! one of the tag's triangles); its diameter is `2 sqrt(d A / pi)` (lattice, jittered) with
+//! `A` the cell area and `d` the density at the cell centre, so the dots cover the fraction
+//! `d(x)` of the face around `x`; stochastic dots overlap and are sized
+//! `2 sqrt(-ln(1 - d) A / pi)` so that their union covers that fraction. The DXF is plain R12 ASCII: one `CIRCLE`
 //! entity per dot on layer `DOTS` (declared in the `TABLES` section), in millimetres; R12
 //! has no units variable, so the units and the frame are stated in `999` comments.
 
@@ -92,36 +96,39 @@ impl SheetFrame {
 }
 
 /// Every dot whose centre lies on the face made of `triangles` (scene coordinates, the
-/// same frame as `pattern.origin`), in row order. Dots of zero diameter are left out.
-pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Vec<Dot> {
-    let h = pattern.row_spacing();
-    let p = pattern.pitch;
+/// same frame as `pattern.origin`), placed as the pattern's `placement` says, in row
+/// order. Dots of zero diameter are left out. A `virtual` pattern prints no dots: that is
+/// an error naming the printable placements.
+pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Result<Vec<Dot>> {
+    if !pattern.placement.printable() {
+        bail!(
+            "placement \"virtual\" is not printable (each hit meets ink with probability d; there are no dots to print): \
+             export a printable placement of the same density instead (\"lattice\", \"jittered\" or \"stochastic\")"
+        );
+    }
     let mut seen = HashSet::new();
-    let mut cells = Vec::new();
+    let mut dots = Vec::new();
     for tri in triangles {
         let q = tri.map(|v| pattern.face_coords(v));
         let (lo, hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
-        let (j0, j1) = ((lo.y / h).floor() as i64 - 1, (hi.y / h).ceil() as i64 + 1);
-        let (i0, i1) = ((lo.x / p).floor() as i64 - 1, (hi.x / p).ceil() as i64 + 1);
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let c = pattern.cell_centre(i, j);
-                if inside_triangle(c, q) && seen.insert((j, i)) {
-                    cells.push((j, i, c));
+        for (i, j) in pattern.cells_over(lo, hi) {
+            for (k, d) in pattern.dots_of_cell(i, j).into_iter().enumerate() {
+                if inside_triangle(d.centre, q) && seen.insert((j, i, k)) {
+                    dots.push(((j, i, k), d));
                 }
             }
         }
     }
-    cells.sort_by_key(|&(j, i, _)| (j, i));
-    cells
+    dots.sort_by_key(|&(key, _)| key);
+    Ok(dots
         .into_iter()
-        .map(|(_, _, c)| Dot {
-            x: c.x,
-            y: c.y,
-            diameter: 2.0 * pattern.dot_radius_at_cell(c),
+        .map(|(_, d)| Dot {
+            x: d.centre.x,
+            y: d.centre.y,
+            diameter: 2.0 * d.radius,
         })
         .filter(|d| d.diameter > 0.0)
-        .collect()
+        .collect())
 }
 
 /// Point in triangle (2-D), boundary included; works for either winding.

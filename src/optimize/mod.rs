@@ -29,7 +29,10 @@
 //!   `1000 + violation`.
 //! - [`feedback`]: per-strip damped ratio updates of a tabulated density (or per cell of a
 //!   density grid with `--dims 2`).
-//! - [`export`]: `dots.csv`, `dots.svg`, `dots.dxf`.
+//! - [`export`]: `dots.csv`, `dots.svg`, `dots.dxf`, placed as the surface's `placement`
+//!   says. A `placement = "virtual"` surface has no dots to print: optimize writes no dot
+//!   files for it unless `--export-placement lattice|jittered|stochastic` asks for a
+//!   printable sheet of the same density.
 //!
 //! After the search, the first and the final design are both re-traced with a fresh seed
 //! and more photons (`--verify-photons`), and [`OptimizeResult::write`] writes
@@ -64,10 +67,11 @@ pub use result::{OptimizeResult, Verification, VerifiedDesign};
 pub use search::violation;
 pub use write::OUTPUT_NAMES;
 
+use crate::optics::dots::DotPattern;
 use crate::scene::Scene;
 use anyhow::{Result, bail};
 use feedback_search::run_feedback;
-use options::check_method_options;
+use options::{check_method_options, export_placement};
 use polynomial_search::run_nelder_mead;
 use search::Search;
 
@@ -79,6 +83,8 @@ pub fn optimize(
 ) -> Result<OptimizeResult> {
     check_method_options(options)?;
     let mut search = Search::new(scene, options)?;
+    let tag = scene.tags[search.tag_id].clone();
+    let dots_placement = export_placement(search.pattern.placement, &tag, options)?;
     let initial_density = search.pattern.density.clone();
     let termination = match options.method {
         Method::NelderMead => run_nelder_mead(&mut search, progress)?,
@@ -93,7 +99,16 @@ pub fn optimize(
     let mut pattern = search.pattern.clone();
     pattern.density = final_density.clone();
     let face = search.face_triangles();
-    let dots = export::dots_on_face(&pattern, &face);
+    let dots = match dots_placement {
+        Some(placement) => Some(export::dots_on_face(
+            &DotPattern {
+                placement,
+                ..pattern.clone()
+            },
+            &face,
+        )?),
+        None => None,
+    };
     let sheet = export::SheetFrame::of_face(&pattern, &face, search.scene.offset);
     let (initial_run, final_run, verification) =
         match verify::verify(&search, &initial_density, &final_density)? {
@@ -104,7 +119,7 @@ pub fn optimize(
         method: options.method,
         options: options.clone(),
         scene_file: scene.path.clone(),
-        tag: scene.tags[search.tag_id].clone(),
+        tag,
         initial_density,
         final_density,
         iterations: search.history.last().map_or(0, |r| r.iteration),
@@ -117,6 +132,7 @@ pub fn optimize(
         best: best_ev,
         verification,
         dots,
+        dots_placement,
         sheet,
         pattern,
         initial_run,

@@ -1,6 +1,7 @@
 //! How to optimize: the method and the options of `blutrace optimize`, checked.
 
 use crate::accel::BackendChoice;
+use crate::optics::dots::Placement;
 use crate::optics::surface::Estimator;
 use anyhow::{Result, bail};
 use clap::{Args, FromArgMatches};
@@ -106,6 +107,12 @@ pub struct OptimizeOptions {
     /// Analog roulette or absorption by weights.
     #[arg(long, value_enum, default_value = "analog")]
     pub estimator: Estimator,
+    /// For a `placement = "virtual"` surface, which is not printable: write the dot files
+    /// for this printable placement of the same density (lattice, jittered or stochastic,
+    /// drawn with the surface's placement_seed). Without it, a virtual pattern gets no
+    /// dot files.
+    #[arg(long, value_parser = parse_printable)]
+    pub export_placement: Option<Placement>,
 }
 
 impl OptimizeOptions {
@@ -129,6 +136,37 @@ impl Default for OptimizeOptions {
             .try_get_matches_from(["optimize"])
             .expect("no flags parse");
         Self::from_arg_matches(&matches).expect("the defaults are valid options")
+    }
+}
+
+/// A printable placement named on the command line.
+fn parse_printable(s: &str) -> Result<Placement, String> {
+    match Placement::ALL.iter().find(|(n, _)| *n == s) {
+        Some((_, p)) if p.printable() => Ok(*p),
+        Some(_) => Err(format!(
+            "\"{s}\" is not printable (it has no dots): use lattice, jittered or stochastic"
+        )),
+        None => Err(format!(
+            "unknown placement \"{s}\": use lattice, jittered or stochastic"
+        )),
+    }
+}
+
+/// The placement of the dot files: the traced pattern's when it is printable (then
+/// `--export-placement` must not be given), else the one `--export-placement` asks for,
+/// or none (`virtual` without it: no dot files).
+pub(super) fn export_placement(
+    traced: Placement,
+    tag: &str,
+    options: &OptimizeOptions,
+) -> Result<Option<Placement>> {
+    match (traced.printable(), options.export_placement) {
+        (true, None) => Ok(Some(traced)),
+        (true, Some(_)) => bail!(
+            "--export-placement is for virtual patterns: surfaces.{tag} is printed as \"{}\", and its dots are exported as traced",
+            traced.name()
+        ),
+        (false, asked) => Ok(asked),
     }
 }
 

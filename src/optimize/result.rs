@@ -5,7 +5,7 @@ use super::objective::Evaluation;
 use super::report::IterationReport;
 use super::traced::TracedRun;
 use super::{Method, OptimizeOptions};
-use crate::optics::dots::{Density, DotPattern};
+use crate::optics::dots::{Density, DotPattern, Placement};
 use crate::run::summary::Summary;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -67,9 +67,12 @@ pub struct OptimizeResult {
     pub best: Evaluation,
     /// The re-traces with a fresh seed (None with `verify_photons = 0`).
     pub verification: Option<Verification>,
-    /// Every dot of the final pattern (face coordinates).
+    /// Every dot of the final pattern (face coordinates); none for a virtual pattern
+    /// without `--export-placement`.
     #[serde(skip)]
-    pub dots: Vec<Dot>,
+    pub dots: Option<Vec<Dot>>,
+    /// The placement of the dot files (null: none written, the pattern is virtual).
+    pub dots_placement: Option<Placement>,
     /// The printed sheet's frame the exports use.
     #[serde(skip)]
     pub sheet: SheetFrame,

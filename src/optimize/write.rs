@@ -87,9 +87,11 @@ impl OptimizeResult {
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         self.write_charts(&staged)?;
         let sheet = &self.sheet;
-        staged.write_bytes("dots.csv", export::to_csv(&self.dots, sheet).as_bytes())?;
-        staged.write_bytes("dots.svg", export::to_svg(&self.dots, sheet).as_bytes())?;
-        staged.write_bytes("dots.dxf", export::to_dxf(&self.dots, sheet).as_bytes())?;
+        if let Some(dots) = &self.dots {
+            staged.write_bytes("dots.csv", export::to_csv(dots, sheet).as_bytes())?;
+            staged.write_bytes("dots.svg", export::to_svg(dots, sheet).as_bytes())?;
+            staged.write_bytes("dots.dxf", export::to_dxf(dots, sheet).as_bytes())?;
+        }
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
 
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {

@@ -131,6 +131,13 @@ pub struct LedgerSummary {
     pub roulette_w: f64,
     /// Surface interactions.
     pub interactions: u64,
+    /// Surface interactions per tag (every tag; they add up to `interactions`).
+    pub hits_by_tag: BTreeMap<String, u64>,
+    /// Of the hits on each dots tag, those that met ink: `ink_hits / hits` is the
+    /// pattern's per-hit ink fraction (the density `d` for independent hits).
+    pub ink_hits_by_tag: BTreeMap<String, u64>,
+    /// Of the hits on each grooves tag, those whose path met a groove facet.
+    pub groove_hits_by_tag: BTreeMap<String, u64>,
     /// (accounted - emitted) / emitted, computed on the exact sums.
     pub balance_rel_error: f64,
 }
@@ -206,6 +213,15 @@ impl RunResult<'_> {
                 killed_photons: l.killed_photons,
                 roulette_w: l.roulette.value() * w,
                 interactions: l.interactions,
+                hits_by_tag: self
+                    .scene
+                    .tags
+                    .iter()
+                    .cloned()
+                    .zip(l.hits_by_tag.clone())
+                    .collect(),
+                ink_hits_by_tag: self.feature_hits("dots"),
+                groove_hits_by_tag: self.feature_hits("grooves"),
                 balance_rel_error: (l.accounted().0 - l.emitted.0) as f64
                     / (l.emitted.0 as f64).max(1.0),
             },
@@ -251,6 +267,21 @@ impl RunResult<'_> {
             },
             warnings: self.scene.warnings.clone(),
         }
+    }
+}
+
+impl RunResult<'_> {
+    /// The ledger's pattern hits on the tags whose model is `kind` ("dots", "grooves").
+    fn feature_hits(&self, kind: &str) -> BTreeMap<String, u64> {
+        let l = &self.tally.ledger;
+        self.scene
+            .tags
+            .iter()
+            .zip(&self.scene.surfaces)
+            .zip(&l.feature_hits_by_tag)
+            .filter(|((_, m), _)| m.kind() == kind)
+            .map(|((t, _), &n)| (t.clone(), n))
+            .collect()
     }
 }
 

@@ -24,6 +24,8 @@ pub(super) fn dots_density_extremes() -> Row {
                 density: Density::Polynomial(vec![d]),
                 x_unit: XUnit::Normalized,
                 mirror: false,
+                placement: Placement::Lattice,
+                placement_seed: 0,
             };
             let mut g = PhotonRng::new(41, (d * 1e6) as u64);
             let hits = (0..n)

@@ -39,7 +39,7 @@ use thin_plate::*;
 
 use blutrace::accel::{self, BackendChoice};
 use blutrace::geometry::{Mesh, Ray, SurfaceHit, intersect_triangle};
-use blutrace::optics::dots::{Density, DotPattern, Lattice, XUnit};
+use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement, XUnit};
 use blutrace::optics::fresnel;
 use blutrace::optics::surface::{Estimator, Interface, Medium, Outcome, SurfaceModel};
 use blutrace::rng::PhotonRng;

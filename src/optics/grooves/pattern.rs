@@ -244,12 +244,27 @@ impl GroovePattern {
     /// or [`MAX_EVENTS`] events (the caller then uses the smooth mean plane).
     pub fn scatter(
         &self,
-        (n_inside, n_outside): (f64, f64),
+        indices: (f64, f64),
         point: DVec3,
         normal: DVec3,
         dir: DVec3,
         rng: &mut PhotonRng,
     ) -> Option<(DVec3, bool)> {
+        self.scatter_met(indices, point, normal, dir, rng)
+            .map(|(d, inside, _)| (d, inside))
+    }
+
+    /// [`GroovePattern::scatter`], also saying whether the path met a facet of a groove
+    /// (`false`: it met only the flat land between grooves).
+    pub fn scatter_met(
+        &self,
+        (n_inside, n_outside): (f64, f64),
+        point: DVec3,
+        normal: DVec3,
+        dir: DVec3,
+        rng: &mut PhotonRng,
+    ) -> Option<(DVec3, bool, bool)> {
+        let mut met = false;
         let axis = self.axis;
         let (ds0, dz0) = (dir.dot(axis), dir.dot(normal));
         if dz0 == 0.0 {
@@ -287,8 +302,10 @@ impl GroovePattern {
             else {
                 // Left the layer; a missed crossing (a ray exactly through a vertex) could
                 // leave side and direction inconsistent: the direction decides.
-                return (dz != 0.0).then_some((d, dz < 0.0));
+                return (dz != 0.0).then_some((d, dz < 0.0, met));
             };
+            // Segments 1 and 2 are the V's facets, 0 and 3 the lands either side.
+            met |= c.seg == 1 || c.seg == 2;
             at = (at.0 + ds * c.t, at.1 + dz * c.t);
             skip = Some((c.cell, c.seg));
             let m = axis * c.normal.0 + normal * c.normal.1;

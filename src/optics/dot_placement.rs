@@ -1,0 +1,302 @@
+//! Where the dots of a [`super::dots`] pattern sit, and whether a hit meets ink.
+//!
+//! ```toml
+//! [surfaces.lgp_back]
+//! model = "dots"
+//! placement = "stochastic"   # "lattice" (default), "jittered", "stochastic" or "virtual"
+//! placement_seed = 7         # jittered, stochastic: which random screen (default 0)
+//! ```
+//!
+//! With `d` the local density, `p` the pitch and `A` the lattice's cell area:
+//!
+//! - `lattice`: one dot per cell at the cell centre, radius `sqrt(d A / pi)`.
+//! - `jittered`: the lattice's dot moved by a pseudo-random offset, uniform in the disc of
+//!   radius `p/2 - r` around the cell centre. The dot stays inside the circle inscribed in
+//!   its cell, so dots never overlap, they cover the fraction `d` exactly and a point can
+//!   only be covered by the dot of the cell it lies in (one lookup per hit). The price: the
+//!   jitter shrinks as the dots grow (at `d = 0.6` on a square lattice it is `0.06 p`).
+//! - `stochastic`: a coverage-corrected random screen (a Boolean model: Poisson germs,
+//!   disc grains). The face is cut into square buckets of side `p`; bucket `(i, j)` holds
+//!   a Poisson number of dots of mean `p^2 / A` (one per lattice cell on average), uniform
+//!   in the bucket. Dots may overlap, so their radius is `sqrt(-ln(1 - d) A / pi)`: the
+//!   probability that a point is covered, `1 - exp(-lambda pi r^2)`, is then `d` at every
+//!   point, not only on average over a cell. Up to the packing limit `r < 0.82 p`, so the
+//!   dots that can cover a point all sit in its bucket and the 8 around it (O(1) per hit).
+//! - `virtual`: no printed dots: each hit meets ink with probability `d` at the hit point
+//!   (the grid's `d(x, y)` for a density grid), drawn from the photon's own random stream.
+//!   This is the "virtual dots" model of Lee et al. 2005 that other tracers use. It cannot
+//!   be printed: exports refuse it (optimize can export a printable placement instead).
+//!
+//! A lattice correlates the hits of a photon trapped by total internal reflection: its
+//! hits step by the same vector every bounce, so one that falls between dots tends to
+//! fall between dots again (see the README, "Dot placement and correlated extraction").
+//! The random placements draw each cell's dots from `(placement_seed, cell)` only, so the
+//! same seed always gives the same sheet, whatever is traced.
+
+use super::dots::{DotPattern, Lattice};
+use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::{DVec2, DVec3};
+use std::f64::consts::{PI, TAU};
+
+/// How the dots of a pattern are placed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Placement {
+    /// At the lattice's cell centres.
+    #[default]
+    Lattice,
+    /// Each moved within its cell by a pseudo-random offset, without overlap.
+    Jittered,
+    /// A coverage-corrected Poisson screen (overlap allowed).
+    Stochastic,
+    /// No printed dots: ink with probability `d` per hit.
+    Virtual,
+}
+
+impl serde::Serialize for Placement {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// Largest `placement_seed`: TOML integers are signed 64-bit.
+pub const MAX_PLACEMENT_SEED: i64 = i64::MAX;
+
+/// Keeps the dots' random numbers apart from the photons' streams of the same seed.
+const PLACEMENT_KEY: u64 = 0x6a09_e667_f3bc_c908;
+
+impl Placement {
+    /// Every placement, by its scene-file name.
+    pub const ALL: [(&'static str, Placement); 4] = [
+        ("lattice", Placement::Lattice),
+        ("jittered", Placement::Jittered),
+        ("stochastic", Placement::Stochastic),
+        ("virtual", Placement::Virtual),
+    ];
+
+    /// The scene-file name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, p)| *p == self)
+            .map_or("lattice", |(n, _)| n)
+    }
+
+    /// The placement named `name` (`None`: the default), else an error at `field`.
+    pub fn parse(ctx: &Ctx, field: &str, name: Option<&str>) -> Result<Placement> {
+        let Some(name) = name else {
+            return Ok(Placement::default());
+        };
+        Self::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, p)| *p)
+            .ok_or_else(|| {
+                ctx.err(
+                    field,
+                    format!(
+                        "unknown placement \"{name}\": use \"lattice\", \"jittered\", \"stochastic\" or \"virtual\""
+                    ),
+                )
+            })
+    }
+
+    /// False for `virtual`, which prints nothing.
+    pub fn printable(self) -> bool {
+        self != Placement::Virtual
+    }
+
+    /// Whether `placement_seed` means anything (the random screens, and `virtual`, whose
+    /// printable stand-in an export may draw).
+    fn uses_seed(self) -> bool {
+        self != Placement::Lattice
+    }
+
+    /// Check `placement_seed` (at `field`) for this placement; `None` gives 0.
+    pub fn seed(self, ctx: &Ctx, field: &str, seed: Option<i64>) -> Result<u64> {
+        match seed {
+            None => Ok(0),
+            Some(_) if !self.uses_seed() => Err(ctx.err(
+                field,
+                "only the jittered and stochastic placements (and virtual, for exports) take a seed; the lattice has no randomness",
+            )),
+            Some(s) if s < 0 => Err(ctx.err(
+                field,
+                format!("{s} is out of range: give a whole number from 0 to {MAX_PLACEMENT_SEED}"),
+            )),
+            Some(s) => Ok(s as u64),
+        }
+    }
+}
+
+/// One printed dot in face coordinates (mm along `axis`, mm along `across`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlacedDot {
+    /// Centre.
+    pub centre: DVec2,
+    /// Radius (mm).
+    pub radius: f64,
+}
+
+impl DotPattern {
+    /// The cell (column `i`, row `j`) whose lattice point is nearest to `q` (face
+    /// coordinates): the cell `q` lies in.
+    pub fn nearest_cell(&self, q: DVec2) -> (i64, i64) {
+        let p = self.pitch;
+        match self.lattice {
+            Lattice::Square => ((q.x / p).floor() as i64, (q.y / p).floor() as i64),
+            Lattice::Hex => {
+                let j0 = (q.y / self.row_spacing() - 0.5).floor() as i64;
+                [j0, j0 + 1]
+                    .map(|j| {
+                        let shift = if j.rem_euclid(2) == 1 { 0.5 } else { 0.0 };
+                        (((q.x / p - shift) - 0.5).round() as i64, j)
+                    })
+                    .into_iter()
+                    .min_by(|a, b| {
+                        let d = |c: &(i64, i64)| self.cell_centre(c.0, c.1).distance_squared(q);
+                        d(a).total_cmp(&d(b))
+                    })
+                    .expect("two candidates")
+            }
+        }
+    }
+
+    /// Radius of a dot of the stochastic screen where the density is `d`: the Boolean
+    /// model covers `1 - exp(-pi r^2 / A)` of the face, which this makes `d`.
+    fn stochastic_radius(&self, d: f64) -> f64 {
+        let a = self.lattice.cell_area(self.pitch);
+        (-(1.0 - d.clamp(0.0, 1.0)).ln() * a / PI).max(0.0).sqrt()
+    }
+
+    /// The random numbers of cell or bucket `(i, j)`.
+    fn cell_rng(&self, i: i64, j: i64) -> PhotonRng {
+        let key = ((i as u32 as u64) << 32) | j as u32 as u64;
+        PhotonRng::new(self.placement_seed ^ PLACEMENT_KEY, key)
+    }
+
+    /// The dot of lattice cell `(i, j)`, placed as the lattice or the jitter says.
+    fn cell_dot(&self, i: i64, j: i64) -> PlacedDot {
+        let c = self.cell_centre(i, j);
+        let radius = self.dot_radius_at_cell(c);
+        if self.placement != Placement::Jittered {
+            return PlacedDot { centre: c, radius };
+        }
+        let mut g = self.cell_rng(i, j);
+        let reach = (0.5 * self.pitch - radius).max(0.0) * g.uniform().sqrt();
+        let angle = TAU * g.uniform();
+        PlacedDot {
+            centre: c + reach * DVec2::new(angle.cos(), angle.sin()),
+            radius,
+        }
+    }
+
+    /// The dots of the stochastic screen's bucket `(i, j)` (square, side `pitch`).
+    fn bucket_dots(&self, i: i64, j: i64) -> BucketDots<'_> {
+        let mut rng = self.cell_rng(i, j);
+        let mean = self.pitch * self.pitch / self.lattice.cell_area(self.pitch);
+        let count = poisson(mean, rng.uniform());
+        BucketDots {
+            pattern: self,
+            rng,
+            corner: DVec2::new(i as f64, j as f64) * self.pitch,
+            left: count,
+        }
+    }
+
+    /// Every dot of cell `(i, j)`: the lattice cell (lattice, jittered) or the bucket
+    /// (stochastic); none for `virtual`.
+    pub fn dots_of_cell(&self, i: i64, j: i64) -> Vec<PlacedDot> {
+        match self.placement {
+            Placement::Lattice | Placement::Jittered => vec![self.cell_dot(i, j)],
+            Placement::Stochastic => self.bucket_dots(i, j).collect(),
+            Placement::Virtual => Vec::new(),
+        }
+    }
+
+    /// The cells `(i, j)` whose dots may have their centre in the face-coordinate box
+    /// `lo..hi` (lattice cells, or the stochastic screen's buckets).
+    pub fn cells_over(&self, lo: DVec2, hi: DVec2) -> impl Iterator<Item = (i64, i64)> {
+        let (sx, sy) = match self.placement {
+            Placement::Stochastic => (self.pitch, self.pitch),
+            _ => (self.pitch, self.row_spacing()),
+        };
+        let (j0, j1) = (
+            (lo.y / sy).floor() as i64 - 1,
+            (hi.y / sy).ceil() as i64 + 1,
+        );
+        let (i0, i1) = (
+            (lo.x / sx).floor() as i64 - 1,
+            (hi.x / sx).ceil() as i64 + 1,
+        );
+        (j0..=j1).flat_map(move |j| (i0..=i1).map(move |i| (i, j)))
+    }
+
+    /// True when the face point `p` lies inside a printed dot (never for `virtual`,
+    /// which prints none: see [`DotPattern::meets_ink`]).
+    pub fn covers(&self, p: DVec3) -> bool {
+        let q = self.face_coords(p);
+        let inside = |d: PlacedDot| q.distance_squared(d.centre) < d.radius * d.radius;
+        match self.placement {
+            Placement::Lattice | Placement::Jittered => {
+                let (i, j) = self.nearest_cell(q);
+                inside(self.cell_dot(i, j))
+            }
+            Placement::Stochastic => {
+                let (bi, bj) = (
+                    (q.x / self.pitch).floor() as i64,
+                    (q.y / self.pitch).floor() as i64,
+                );
+                (bj - 1..=bj + 1)
+                    .any(|j| (bi - 1..=bi + 1).any(|i| self.bucket_dots(i, j).any(inside)))
+            }
+            Placement::Virtual => false,
+        }
+    }
+
+    /// Whether a photon hitting the face at `p` meets ink: a printed dot there, or for
+    /// `virtual` a draw from the photon's stream with probability `d` at `p`.
+    pub fn meets_ink(&self, p: DVec3, rng: &mut PhotonRng) -> bool {
+        match self.placement {
+            Placement::Virtual => rng.uniform() < self.density_at_point(self.face_coords(p)),
+            _ => self.covers(p),
+        }
+    }
+}
+
+/// The dots of one bucket of the stochastic screen, drawn as they are asked for.
+struct BucketDots<'a> {
+    pattern: &'a DotPattern,
+    rng: PhotonRng,
+    corner: DVec2,
+    left: u32,
+}
+
+impl Iterator for BucketDots<'_> {
+    type Item = PlacedDot;
+
+    fn next(&mut self) -> Option<PlacedDot> {
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        let p = self.pattern;
+        let centre = self.corner + DVec2::new(self.rng.uniform(), self.rng.uniform()) * p.pitch;
+        let radius = p.stochastic_radius(p.density_at_point(centre));
+        Some(PlacedDot { centre, radius })
+    }
+}
+
+/// The Poisson variate of mean `mean` at the uniform `u` (inversion; at most 64).
+fn poisson(mean: f64, u: f64) -> u32 {
+    let mut term = (-mean).exp();
+    let mut cdf = term;
+    let mut k = 0;
+    while u >= cdf && k < 64 {
+        k += 1;
+        term *= mean / k as f64;
+        cdf += term;
+    }
+    k
+}

@@ -176,6 +176,39 @@ pub fn guide_scene(name: &str) -> Scene {
     ))
 }
 
+/// The guide of [`guide_scene`] reduced to the question of where the light goes: 120 x 80
+/// x 3 mm lossless PMMA lit through its x = 0 edge by the same Lambertian strip, every
+/// face a smooth dielectric except the back (tag `dots`, the `[surfaces.dots]` fields
+/// given in `dots`, `inside` already set), no sheet, and the target just beyond the far
+/// edge (x = 120): its `detected_w` is the power that leaves through the far edge.
+pub fn edge_lit_slab(name: &str, dots: &str) -> Scene {
+    edge_lit_slab_lit_by(
+        name,
+        dots,
+        "[[sources]]\ntype = \"led\"\ncenter = [-0.01, 40.0, 1.5]\nnormal = [1.0, 0.0, 0.0]\n\
+         u = [0.0, 1.0, 0.0]\nwidth_mm = 80.0\nheight_mm = 3.0\npower_w = 1.0\n",
+    )
+}
+
+/// [`edge_lit_slab`] lit by the `[[sources]]` given (TOML) instead of its strip.
+pub fn edge_lit_slab_lit_by(name: &str, dots: &str, sources: &str) -> Scene {
+    let guide = box_obj(
+        [0.0, 0.0, 0.0],
+        [120.0, 80.0, 3.0],
+        ["edge", "edge", "edge", "edge", "dots", "face"],
+    );
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"guide.obj\"\n[media.pmma]\nn = 1.49\n\
+         [surfaces.face]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\norigin = [0.0, 0.0, 0.0]\n\
+         axis = [1.0, 0.0, 0.0]\nlength_mm = 120.0\n{dots}\n{sources}\
+         [detector]\norigin = [120.01, 0.0, 0.0]\nu = [0.0, 1.0, 0.0]\nv = [0.0, 0.0, 1.0]\n\
+         size_mm = [80.0, 3.0]\nbins = [8, 1]\n"
+    );
+    load(&write_scene(name, &toml, &[("guide.obj", &guide)]))
+}
+
 /// Wilson-Hilferty: the chi-square quantile for `k` degrees of freedom at normal score `z`.
 pub fn chi2_quantile(k: f64, z: f64) -> f64 {
     let a = 2.0 / (9.0 * k);

@@ -385,6 +385,53 @@ fn table() {
     }
 }
 
+/// The README's second table: the guide of `support::guide_scene` (graded hex dots
+/// d = 0.1 + 0.3 x, ink albedo 0.9, a white sheet behind, the target above), its
+/// extraction and the flux on the last sixth of the target (x > 100 mm), per placement;
+/// and the lattice's gap on the slab at other pitches.
+#[test]
+#[ignore]
+fn table_guide() {
+    println!("| placement | extraction | flux at x > 100 mm (fraction of emitted) |");
+    println!("|---|---|---|");
+    let stochastic = (0..4).map(|k| format!("stochastic\"\nplacement_seed = {k}"));
+    for placement in ["lattice\"".to_string(), "jittered\"".to_string()]
+        .into_iter()
+        .chain(stochastic)
+        .chain(["virtual\"".to_string()])
+    {
+        let scene = support::guide_scene_with("guide", &format!("placement = \"{placement}"));
+        let placement = placement
+            .replace("\"\nplacement_seed = ", ", seed ")
+            .replace('"', "");
+        let r = trace(&scene, 1_000_000, Estimator::Analog, 2);
+        let l = &r.tally.ledger;
+        let (e, se) = l.detected.mean_and_stderr(l.photons);
+        let f = &r.tally.flux;
+        let (mut sum, mut sumsq) = (0.0, 0.0);
+        for iy in 0..f.ny {
+            for ix in 20..f.nx {
+                let b = &f.bins[iy * f.nx + ix];
+                sum += b.sum.value();
+                sumsq += b.sumsq.value();
+            }
+        }
+        let (m, sm) = blutrace::tally::mean_and_stderr(sum, sumsq, l.photons);
+        println!("| {placement} | {e:.4} ± {se:.4} | {m:.4} ± {sm:.4} |");
+    }
+    println!();
+    println!("| slab, d = 0.3, lattice pitch (mm) | per-hit ink fraction | power into ink |");
+    println!("|---|---|---|");
+    for pitch in [0.05, 0.1, 0.5, 1.0] {
+        let scene = edge_lit_slab(
+            &format!("pitch-{pitch}"),
+            &dots("lattice", 0.3).replace("pitch_mm = 0.5", &format!("pitch_mm = {pitch}")),
+        );
+        let b = books(&trace(&scene, 1_000_000, Estimator::Analog, 2));
+        println!("| {pitch} | {:.4} | {:.4} |", b.ink_fraction(), b.ink_power);
+    }
+}
+
 /// Walk `photons` photons through an infinite slab `0 <= z <= 3` of the `scene`'s PMMA,
 /// entering at x = 0 (a Lambertian strip in air, refracted), until they leave the slab,
 /// meet black ink or pass x = 120 mm: the back face `z = 0` is the scene's `back` tag

@@ -152,26 +152,33 @@ pub fn plate_scene(name: &str) -> Scene {
 /// Lambertian strip covering that edge, graded hex dots on the back, a Lambert sheet under
 /// it and a target plane above. Long TIR paths make its photons draw many numbers each.
 pub fn guide_scene(name: &str) -> Scene {
+    guide_scene_with(name, "")
+}
+
+/// [`guide_scene`] with more `[surfaces.dots]` fields (TOML lines, e.g. a placement).
+pub fn guide_scene_with(name: &str, dots: &str) -> Scene {
     let guide = box_obj(
         [0.0, 0.0, 0.0],
         [120.0, 80.0, 3.0],
         ["edge", "edge", "edge", "edge", "dots", "face"],
     );
     let sheet = "v -2 -2 -0.2\nv 122 -2 -0.2\nv 122 82 -0.2\nv -2 82 -0.2\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
-    let toml = "version = 1\n[[geometry]]\nfile = \"guide.obj\"\n[[geometry]]\nfile = \"sheet.obj\"\n\
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"guide.obj\"\n[[geometry]]\nfile = \"sheet.obj\"\n\
          [media.pmma]\nn = 1.49\n\
          [surfaces.face]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
          [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
          [surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.95\n\
          [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"hex\"\npitch_mm = 0.5\n\
-         origin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 120.0\ndensity = [0.1, 0.3]\n\
+         origin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 120.0\ndensity = [0.1, 0.3]\n{dots}\n\
          [[sources]]\ntype = \"led\"\ncenter = [-0.01, 40.0, 1.5]\nnormal = [1.0, 0.0, 0.0]\n\
          u = [0.0, 1.0, 0.0]\nwidth_mm = 80.0\nheight_mm = 3.0\npower_w = 1.0\n\
          [detector]\norigin = [0.0, 0.0, 3.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-         size_mm = [120.0, 80.0]\nbins = [24, 16]\n";
+         size_mm = [120.0, 80.0]\nbins = [24, 16]\n"
+    );
     load(&write_scene(
         name,
-        toml,
+        &toml,
         &[("guide.obj", &guide), ("sheet.obj", sheet)],
     ))
 }

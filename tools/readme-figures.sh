@@ -3,7 +3,7 @@
 # and the bench table. Results are deterministic (fixed seeds); only the timings depend on
 # the machine and its load, so run it on a quiet machine.
 #
-#   bash tools/readme-figures.sh [gallery|optimize|bench|bodies|all]   (default: all)
+#   bash tools/readme-figures.sh [gallery|optimize|bench|bodies|placement|all]   (default: all)
 #
 # Logs go to out/figures/*.log; the README tables are filled in from them by hand.
 set -euo pipefail
@@ -71,6 +71,13 @@ PY
   done
 }
 
+# "Dot placement and correlated extraction": the slab and guide tables per placement and
+# the grooves walk (deterministic; about a minute).
+placement() {
+  cargo test --release -q --test dot_placement -- --ignored --nocapture --test-threads 1 \
+    table table_guide grooves_table >"$out/placement.log" 2>&1
+}
+
 bench() {
   "$bin" bench --photons 200000 >"$out/bench.log" 2>&1
 }
@@ -80,6 +87,7 @@ case "$what" in
   optimize) optimize ;;
   bench) bench ;;
   bodies) bodies ;;
-  all) gallery; bodies; optimize; bench ;;
-  *) echo "usage: $0 [gallery|optimize|bench|bodies|all]" >&2; exit 2 ;;
+  placement) placement ;;
+  all) gallery; bodies; optimize; placement; bench ;;
+  *) echo "usage: $0 [gallery|optimize|bench|bodies|placement|all]" >&2; exit 2 ;;
 esac

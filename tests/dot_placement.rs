@@ -297,30 +297,32 @@ fn lattice_beam_between_rows_meets_no_ink() {
     assert!(v.far_edge.0 < 0.05, "virtual far edge {:?}", v.far_edge);
 }
 
+/// A 10 x 10 x 1 mm plate with square dots (d = 0.3) and `dots` more dots fields.
+fn small_plate(name: &str, dots: &str) -> support::SceneDir {
+    let guide = support::box_obj(
+        [0.0, 0.0, 0.0],
+        [10.0, 10.0, 1.0],
+        ["edge", "edge", "edge", "edge", "dots", "edge"],
+    );
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"g.obj\"\n[media.pmma]\nn = 1.49\n\
+         [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+         [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"square\"\n\
+         pitch_mm = 0.5\norigin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 10.0\n\
+         density = [0.3]\n{dots}\n\
+         [[sources]]\ntype = \"led\"\ncenter = [-0.01, 5.0, 0.5]\nnormal = [1.0, 0.0, 0.0]\n\
+         u = [0.0, 1.0, 0.0]\nwidth_mm = 10.0\nheight_mm = 1.0\npower_w = 1.0\n\
+         [detector]\norigin = [0.0, 0.0, 1.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [10.0, 10.0]\nbins = [4, 4]\n"
+    );
+    support::write_scene(name, &toml, &[("g.obj", &guide)])
+}
+
 #[test]
 fn bad_placements_are_refused_naming_the_field() {
-    let err = |dots: &str| {
-        let guide = support::box_obj(
-            [0.0, 0.0, 0.0],
-            [10.0, 10.0, 1.0],
-            ["edge", "edge", "edge", "edge", "dots", "edge"],
-        );
-        let toml = format!(
-            "version = 1\n[[geometry]]\nfile = \"g.obj\"\n[media.pmma]\nn = 1.49\n\
-             [surfaces.edge]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
-             [surfaces.dots]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"square\"\n\
-             pitch_mm = 0.5\norigin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 10.0\n\
-             density = [0.3]\n{dots}\n\
-             [[sources]]\ntype = \"led\"\ncenter = [-0.01, 5.0, 0.5]\nnormal = [1.0, 0.0, 0.0]\n\
-             u = [0.0, 1.0, 0.0]\nwidth_mm = 10.0\nheight_mm = 1.0\npower_w = 1.0\n\
-             [detector]\norigin = [0.0, 0.0, 1.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-             size_mm = [10.0, 10.0]\nbins = [2, 2]\n"
-        );
-        let dir = support::write_scene("bad-placement", &toml, &[("g.obj", &guide)]);
-        match Scene::load(&dir) {
-            Ok(_) => panic!("{dots}: loaded"),
-            Err(e) => format!("{e:#}"),
-        }
+    let err = |dots: &str| match Scene::load(&small_plate("bad-placement", dots)) {
+        Ok(_) => panic!("{dots}: loaded"),
+        Err(e) => format!("{e:#}"),
     };
     let e = err("placement = \"random\"");
     assert!(
@@ -344,6 +346,74 @@ fn bad_placements_are_refused_naming_the_field() {
     let e = format!("{:#}", export::dots_on_face(&p, &face).unwrap_err());
     assert!(e.contains("\"virtual\" is not printable"), "{e}");
     assert!(!p.covers(DVec3::new(0.25, 0.25, 0.0)));
+}
+
+#[test]
+fn optimize_exports_virtual_dots_only_as_a_printable_placement() {
+    use blutrace::optimize::{Method, OptimizeOptions, optimize};
+    let opts = OptimizeOptions {
+        method: Method::Feedback,
+        photons: 8_000,
+        max_iter: 1,
+        verify_photons: 0,
+        threads: Some(2),
+        ..OptimizeOptions::default()
+    };
+    let dir = small_plate("opt-virtual", "placement = \"virtual\"\nplacement_seed = 3");
+    let scene = support::load(&dir);
+    let out = tempfile::tempdir().unwrap();
+    // Virtual: optimized, but no dot files.
+    let r = optimize(&scene, &opts, &mut |_| {}).unwrap();
+    assert!(r.dots.is_none() && r.dots_placement.is_none());
+    r.write(&out.path().join("a")).unwrap();
+    assert!(out.path().join("a/optimized.toml").is_file());
+    assert!(!out.path().join("a/dots.csv").exists());
+    let json = std::fs::read_to_string(out.path().join("a/optimize.json")).unwrap();
+    assert!(json.contains("\"dots_placement\": null"), "{json}");
+    // On request, a stochastic sheet of the same density, drawn with the surface's seed.
+    let asked = OptimizeOptions {
+        export_placement: Some(Placement::Stochastic),
+        ..opts.clone()
+    };
+    let r = optimize(&scene, &asked, &mut |_| {}).unwrap();
+    assert_eq!(r.dots_placement, Some(Placement::Stochastic));
+    r.write(&out.path().join("b")).unwrap();
+    let csv = std::fs::read_to_string(out.path().join("b/dots.csv")).unwrap();
+    let dots = export::parse_csv(&csv).unwrap();
+    assert_eq!(dots.len(), r.dots.as_ref().unwrap().len());
+    let mut printed = r.pattern.clone();
+    printed.placement = Placement::Stochastic;
+    assert_eq!(printed.placement_seed, 3);
+    assert!(
+        r.dots
+            .as_ref()
+            .unwrap()
+            .iter()
+            .all(|d| printed.covers(printed.origin + printed.axis * d.x + printed.across * d.y)),
+        "the files hold the stochastic screen of the surface's seed"
+    );
+    // A printable surface is exported as traced: asking for another placement is an error.
+    let lattice = support::load(&small_plate("opt-lattice", ""));
+    let e = format!("{:#}", optimize(&lattice, &asked, &mut |_| {}).unwrap_err());
+    assert!(
+        e.contains("--export-placement is for virtual patterns"),
+        "{e}"
+    );
+    // And the command line refuses virtual as an export placement, saying why.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args([
+            "optimize",
+            dir.to_str().unwrap(),
+            "--export-placement",
+            "virtual",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("not printable"),
+        "{stderr}"
+    );
 }
 
 /// The README's table: per-hit ink fraction, ink power and far-edge power of each

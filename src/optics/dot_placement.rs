@@ -300,3 +300,52 @@ fn poisson(mean: f64, u: f64) -> u32 {
     }
     k
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn poisson_inversion_has_the_poisson_probabilities() {
+        // Stratified uniforms: the share of each count is its probability to 1/n.
+        let n = 100_000;
+        for mean in [0.3, 1.0, 2.0 / 3f64.sqrt()] {
+            let mut counts = [0usize; 12];
+            for i in 0..n {
+                counts[poisson(mean, (i as f64 + 0.5) / n as f64) as usize] += 1;
+            }
+            let mut pmf = (-mean).exp();
+            for (k, &c) in counts.iter().enumerate() {
+                if k > 0 {
+                    pmf *= mean / k as f64;
+                }
+                let got = c as f64 / n as f64;
+                assert!(
+                    (got - pmf).abs() <= 1.0 / n as f64,
+                    "mean {mean} k {k}: {got} vs {pmf}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn placements_parse_by_name() {
+        let ctx = Ctx(std::path::Path::new("scene.toml"));
+        for (name, p) in Placement::ALL {
+            assert_eq!(Placement::parse(&ctx, "f", Some(name)).unwrap(), p);
+            assert_eq!(p.name(), name);
+        }
+        assert_eq!(
+            Placement::parse(&ctx, "f", None).unwrap(),
+            Placement::Lattice
+        );
+        assert!(Placement::parse(&ctx, "f", Some("Lattice")).is_err());
+        assert_eq!(
+            Placement::Stochastic
+                .seed(&ctx, "f", Some(i64::MAX))
+                .unwrap(),
+            i64::MAX as u64
+        );
+        assert!(Placement::Virtual.printable() != Placement::Jittered.printable());
+    }
+}

@@ -1,8 +1,11 @@
 //! Procedural ink-dot extraction patterns, never meshed.
 //!
-//! Dots sit at the centres of a square or hexagonal cell lattice on a tagged face. The
-//! dot in a cell covers the fraction `d(x)` of the cell's area, where `d` is a polynomial
-//! in the distance `x` of the cell centre from the lamp edge, measured along `axis`.
+//! A square or hexagonal cell lattice on a tagged face sets the dots' size and number:
+//! the dot of a cell covers the fraction `d(x)` of the cell's area, where `d` is a
+//! polynomial in the distance `x` of the cell centre from the lamp edge, measured along
+//! `axis`. By default each dot sits at its cell centre; `placement` jitters them, puts
+//! them on a coverage-corrected random screen, or replaces them by virtual dots (ink with
+//! probability `d` per hit): see [`super::dot_placement`].
 //!
 //! ```toml
 //! [surfaces.lgp_back]

@@ -21,7 +21,8 @@
 //!   in the bucket. Dots may overlap, so their radius is `sqrt(-ln(1 - d) A / pi)`: the
 //!   probability that a point is covered, `1 - exp(-lambda pi r^2)`, is then `d` at every
 //!   point, not only on average over a cell. Up to the packing limit `r < 0.82 p`, so the
-//!   dots that can cover a point all sit in its bucket and the 8 around it (O(1) per hit).
+//!   dots that can cover a point all sit in its bucket and the 8 around it (O(1) per hit;
+//!   a neighbour farther from the point than the largest radius is not even drawn).
 //! - `virtual`: no printed dots: each hit meets ink with probability `d` at the hit point
 //!   (the grid's `d(x, y)` for a density grid), drawn from the photon's own random stream.
 //!   This is the "virtual dots" model of Lee et al. 2005 that other tracers use. It cannot
@@ -165,9 +166,28 @@ impl DotPattern {
 
     /// Radius of a dot of the stochastic screen where the density is `d`: the Boolean
     /// model covers `1 - exp(-pi r^2 / A)` of the face, which this makes `d`.
+    /// The density is clamped to the lattice's packing limit (which the load checks at
+    /// 4097 points; a polynomial may stray beyond it between them), so no dot is larger
+    /// than [`DotPattern::stochastic_reach`].
     fn stochastic_radius(&self, d: f64) -> f64 {
         let a = self.lattice.cell_area(self.pitch);
-        (-(1.0 - d.clamp(0.0, 1.0)).ln() * a / PI).max(0.0).sqrt()
+        let d = d.clamp(0.0, self.lattice.max_packing());
+        (-(1.0 - d).ln() * a / PI).max(0.0).sqrt()
+    }
+
+    /// The largest radius of a stochastic dot: `0.70 p` (square), `0.81 p` (hex).
+    fn stochastic_reach(&self) -> f64 {
+        self.stochastic_radius(1.0)
+    }
+
+    /// True when a stochastic dot of bucket `(i, j)` could cover `q`: the bucket lies
+    /// within the largest dot radius of `q`.
+    fn bucket_reaches(&self, i: i64, j: i64, q: DVec2) -> bool {
+        let p = self.pitch;
+        let lo = DVec2::new(i as f64, j as f64) * p;
+        let gap = (lo - q).max(q - (lo + p)).max(DVec2::ZERO);
+        let reach = self.stochastic_reach();
+        gap.length_squared() < reach * reach
     }
 
     /// The random numbers of cell or bucket `(i, j)`.
@@ -248,8 +268,12 @@ impl DotPattern {
                     (q.x / self.pitch).floor() as i64,
                     (q.y / self.pitch).floor() as i64,
                 );
-                (bj - 1..=bj + 1)
-                    .any(|j| (bi - 1..=bi + 1).any(|i| self.bucket_dots(i, j).any(inside)))
+                // Its own bucket first, then the neighbours a dot could reach across from.
+                let near = (bj - 1..=bj + 1).flat_map(|j| (bi - 1..=bi + 1).map(move |i| (i, j)));
+                self.bucket_dots(bi, bj).any(inside)
+                    || near
+                        .filter(|&(i, j)| (i, j) != (bi, bj) && self.bucket_reaches(i, j, q))
+                        .any(|(i, j)| self.bucket_dots(i, j).any(inside))
             }
             Placement::Virtual => false,
         }

@@ -70,7 +70,16 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         .zip(&scene.surfaces)
         .zip(scene.triangles_per_tag())
     {
-        println!("  tag {tag:<20} {:<11} {n} triangles", model.kind());
+        let placement = match model {
+            crate::optics::surface::SurfaceModel::Dots { pattern, .. } => {
+                format!(", {} placement", pattern.placement.name())
+            }
+            _ => String::new(),
+        };
+        println!(
+            "  tag {tag:<20} {:<11} {n} triangles{placement}",
+            model.kind()
+        );
     }
     for (i, m) in scene.media.iter().enumerate() {
         let path = match scene.convex_solid(i as u16) {

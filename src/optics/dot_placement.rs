@@ -151,8 +151,8 @@ impl DotPattern {
                 let j0 = (q.y / self.row_spacing() - 0.5).floor() as i64;
                 [j0, j0 + 1]
                     .map(|j| {
-                        let shift = if j.rem_euclid(2) == 1 { 0.5 } else { 0.0 };
-                        (((q.x / p - shift) - 0.5).round() as i64, j)
+                        let shift = if j.rem_euclid(2) == 1 { 0.5 * p } else { 0.0 };
+                        (((q.x - shift) / p - 0.5).round() as i64, j)
                     })
                     .into_iter()
                     .min_by(|a, b| {
@@ -348,6 +348,43 @@ mod tests {
                     (got - pmf).abs() <= 1.0 / n as f64,
                     "mean {mean} k {k}: {got} vs {pmf}"
                 );
+            }
+        }
+    }
+
+    /// The lattice lookup agrees with a brute-force search for the nearest cell centre.
+    #[test]
+    fn lattice_lookup_finds_the_nearest_dot() {
+        use super::super::dots::{Density, XUnit};
+        for lattice in [Lattice::Square, Lattice::Hex] {
+            let p = DotPattern {
+                lattice,
+                pitch: 0.3,
+                origin: DVec3::ZERO,
+                axis: DVec3::X,
+                across: DVec3::Y,
+                length: 50.0,
+                density: Density::Polynomial(vec![0.1, 0.6]),
+                x_unit: XUnit::Normalized,
+                mirror: false,
+                placement: Placement::Lattice,
+                placement_seed: 0,
+            };
+            let mut g = PhotonRng::new(1, 2);
+            for _ in 0..20_000 {
+                let q = DVec2::new(50.0 * g.uniform(), 7.0 * g.uniform() - 3.0);
+                let (i0, j0) = (
+                    (q.x / p.pitch) as i64,
+                    (q.y / p.row_spacing()).floor() as i64,
+                );
+                let nearest = (j0 - 2..=j0 + 2)
+                    .flat_map(|j| (i0 - 2..=i0 + 2).map(move |i| (i, j)))
+                    .map(|(i, j)| p.cell_centre(i, j))
+                    .min_by(|a, b| a.distance_squared(q).total_cmp(&b.distance_squared(q)))
+                    .unwrap();
+                let r = p.dot_radius_at_cell(nearest);
+                let by_hand = q.distance_squared(nearest) < r * r;
+                assert_eq!(p.covers(q.extend(0.0)), by_hand, "{lattice:?} at {q}");
             }
         }
     }

@@ -4,15 +4,19 @@
 //! [trace]
 //! photons = 400000       # default photon count (CLI --photons overrides)
 //! seed = 1               # default seed (CLI --seed overrides)
-//! max_bounces = 100000   # surface events before a photon is killed (counted, not silent)
+//! max_bounces = 100000   # events before a photon is killed (counted, not silent)
 //! ```
 //!
 //! Each photon is traced along straight segments to the nearest surface, where its
-//! surface model decides by Russian roulette to reflect, transmit or absorb it. It ends in
+//! surface model decides by Russian roulette to reflect, transmit or absorb it; inside a
+//! scattering medium a segment may end earlier in a scattering event ([`flight`]). Both
+//! kinds of event count as interactions and towards `max_bounces`. It ends in
 //! exactly one fate: detected, absorbed (by a named surface or medium), escaped, killed
 //! by the bounce cap, or (weighted estimator only) ended by Russian roulette. Work is split
 //! into fixed chunks of photon indices; tallies are exact integer sums, so the result does
 //! not depend on the thread count.
+
+mod flight;
 
 use crate::accel::Accel;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
@@ -20,6 +24,7 @@ use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
+use flight::Flight;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -70,7 +75,7 @@ impl Tracer<'_> {
         out.ledger.end(fate, p.weight);
     }
 
-    /// The photon loop: nearest event, Beer-Lambert, surface roulette, repeat.
+    /// The photon loop: nearest event, the medium on the way, surface roulette, repeat.
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
         for _ in 0..scene.max_bounces {
@@ -79,8 +84,16 @@ impl Tracer<'_> {
             let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
             let detected = scene.detector.intersect(&true_ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
-            if !self.cross_medium(p, t_next, rng, &mut out.ledger) {
-                return Fate::AbsorbedInMedium(p.medium);
+            match self.cross_medium(p, &true_ray, t_next, rng, &mut out.ledger) {
+                Flight::Absorbed => return Fate::AbsorbedInMedium(p.medium),
+                Flight::Scattered { .. } => {
+                    out.ledger.interactions += 1;
+                    if !roulette(p, rng, &mut out.ledger) {
+                        return Fate::Roulette;
+                    }
+                    continue;
+                }
+                Flight::Reached => {}
             }
             if let Some((_, ab)) = detected {
                 out.detections
@@ -193,21 +206,37 @@ impl Tracer<'_> {
         }
     }
 
-    /// Beer-Lambert over a segment of length `t`: false when the photon is absorbed
-    /// (analog); in weighted mode the weight is attenuated and booked to the medium.
+    /// The medium along `true_ray` up to the next event at `t`. Clear media: Beer-Lambert
+    /// (analog: absorbed or not; weighted: the weight attenuated and the loss booked to
+    /// the medium). Scattering media: a free flight ([`flight::fly`]) that may end in a
+    /// scattering event, after which `p` travels on from the scattering point.
     fn cross_medium(
         &self,
         p: &mut Photon,
+        true_ray: &Ray,
         t: f64,
         rng: &mut PhotonRng,
         ledger: &mut Ledger,
-    ) -> bool {
-        let a = self.scene.media[p.medium as usize].absorption_per_mm;
+    ) -> Flight {
+        let medium = &self.scene.media[p.medium as usize];
+        let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
+        if medium.scattering.per_mm > 0.0 {
+            let eps = self.scene.spawn_eps;
+            let (w, dir) = (&mut p.weight, true_ray.dir);
+            let flight = flight::fly(medium, self.estimator, w, dir, t, eps, rng, sink);
+            if let Flight::Scattered { t, dir } = flight {
+                // Inside the medium, clear of surfaces: the search needs no nudge.
+                p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
+            }
+            return flight;
+        }
+        let a = medium.absorption_per_mm;
         if a == 0.0 {
-            return true;
+            return Flight::Reached;
         }
         match self.estimator {
-            Estimator::Analog => -(1.0 - rng.uniform()).ln() / a >= t,
+            Estimator::Analog if -(1.0 - rng.uniform()).ln() / a >= t => Flight::Reached,
+            Estimator::Analog => Flight::Absorbed,
             Estimator::Weighted => {
                 // An escaping photon (t infinite) loses nothing more inside this medium.
                 let w = if t.is_finite() {
@@ -215,13 +244,9 @@ impl Tracer<'_> {
                 } else {
                     p.weight
                 };
-                Ledger::lose(
-                    &mut ledger.absorbed_in_medium[p.medium as usize],
-                    p.weight,
-                    w,
-                );
+                Ledger::lose(sink, p.weight, w);
                 p.weight = w;
-                true
+                Flight::Reached
             }
         }
     }

@@ -18,16 +18,8 @@ const PMMA: f64 = 1.49;
 
 fn media() -> Vec<Medium> {
     vec![
-        Medium {
-            name: "air".into(),
-            n: 1.0,
-            absorption_per_mm: 0.0,
-        },
-        Medium {
-            name: "pmma".into(),
-            n: PMMA,
-            absorption_per_mm: 0.0,
-        },
+        Medium::clear("air", 1.0, 0.0),
+        Medium::clear("pmma", PMMA, 0.0),
     ]
 }
 

@@ -2,6 +2,7 @@
 //! with sizes in mm (or `--json` for scripts).
 
 use crate::accel::BackendChoice;
+use crate::optics::medium::Medium;
 use crate::scene::Scene;
 use crate::scene::geometry_report::BoxMm;
 use anyhow::Result;
@@ -23,6 +24,48 @@ fn bounds(b: Option<BoxMm>) -> String {
     )
 }
 
+/// ", scattering ... /mm, g ..." for a check line (empty for a clear medium), with the
+/// particles the coefficients come from.
+fn scattering(m: &Medium) -> String {
+    let s = &m.scattering;
+    if s.per_mm == 0.0 {
+        return String::new();
+    }
+    let from = match &m.particles {
+        Some(p) => format!(
+            " (Mie: spheres r = {} um, n = {}{}, volume fraction {}, at {} nm)",
+            p.radius_um,
+            p.n,
+            if p.k > 0.0 {
+                format!(" + {}i", p.k)
+            } else {
+                String::new()
+            },
+            p.volume_fraction,
+            p.wavelength_nm
+        ),
+        None => String::new(),
+    };
+    format!(
+        ", scattering {:.6} /mm, anisotropy g = {:.4}, reduced {:.6} /mm{from}",
+        s.per_mm,
+        s.anisotropy,
+        s.reduced_per_mm()
+    )
+}
+
+/// One medium for `check --json`.
+fn medium_json(m: &Medium) -> serde_json::Value {
+    serde_json::json!({
+        "name": m.name,
+        "n": m.n,
+        "absorption_per_mm": m.absorption_per_mm,
+        "scattering_per_mm": m.scattering.per_mm,
+        "anisotropy": m.scattering.anisotropy,
+        "particles": m.particles,
+    })
+}
+
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     let scene = Scene::load(path)?;
     let tally_bytes = crate::run::check_tally_budget(&scene)?;
@@ -38,6 +81,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
                 "medium": scene.media[s.medium as usize].name,
                 "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
             })).collect::<Vec<_>>(),
+            "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),
             "warnings": scene.warnings,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -88,8 +132,11 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             None => "backend (not a lone convex solid)".to_string(),
         };
         println!(
-            "medium     {:<20} n = {}, absorption {} /mm; {path}",
-            m.name, m.n, m.absorption_per_mm
+            "medium     {:<20} n = {}, absorption {} /mm{}; {path}",
+            m.name,
+            m.n,
+            m.absorption_per_mm,
+            scattering(m)
         );
     }
     let backend = crate::accel::build(BackendChoice::Auto, scene.mesh.clone())?;

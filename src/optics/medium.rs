@@ -4,10 +4,23 @@
 //! [media.pmma]
 //! n = 1.49
 //! absorption_per_mm = 0.0002   # Beer-Lambert coefficient (natural log), 0 = lossless
+//!
+//! [media.diffuser_pc]          # a bulk diffuser: scatters inside
+//! n = 1.585
+//! absorption_per_mm = 0.001
+//! scattering_per_mm = 4.0      # mu_s, 1/mm (default 0: clear)
+//! anisotropy = 0.9             # Henyey-Greenstein g in (-1, 1) (default 0: isotropic)
+//!
+//! [media.diffusion_pmma]       # or mu_s and g from particles (Mie, see `mie`)
+//! n = 1.49
+//! particles = { radius_um = 2.0, n = 1.43, volume_fraction = 0.001, wavelength_nm = 550.0 }
 //! ```
 //!
-//! The medium `air` (n = 1, lossless) exists unless the file redefines it; surfaces and
-//! sources name media, the scene numbers them ([`MediumId`]).
+//! The medium `air` (n = 1, lossless, clear) exists unless the file redefines it; it is
+//! the unbounded ambient medium, so it may absorb but not scatter. Surfaces and sources
+//! name media, the scene numbers them ([`MediumId`]). How a photon crosses a medium
+//! (free paths, scattering events) is the tracer's (`tracer::flight`); the phase
+//! function is [`super::phase`].
 
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -24,8 +37,48 @@ pub struct Medium {
     pub name: String,
     /// Refractive index.
     pub n: f64,
-    /// Beer-Lambert absorption coefficient (1/mm).
+    /// Beer-Lambert absorption coefficient (1/mm): the bulk's and its particles'.
     pub absorption_per_mm: f64,
+    /// Scattering inside the medium ([`Scattering::NONE`] for a clear one).
+    pub scattering: Scattering,
+    /// The particles the scattering was computed from, if any (for reports).
+    pub particles: Option<ParticlesSpec>,
+}
+
+impl Medium {
+    /// A medium that does not scatter.
+    pub fn clear(name: &str, n: f64, absorption_per_mm: f64) -> Medium {
+        Medium {
+            name: name.to_string(),
+            n,
+            absorption_per_mm,
+            scattering: Scattering::NONE,
+            particles: None,
+        }
+    }
+}
+
+/// Volume scattering: free paths of mean `1 / per_mm` between events, and the phase
+/// function's anisotropy.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scattering {
+    /// Scattering coefficient mu_s (1/mm); 0 = clear.
+    pub per_mm: f64,
+    /// Henyey-Greenstein anisotropy g, the mean cosine of the scattering angle.
+    pub anisotropy: f64,
+}
+
+impl Scattering {
+    /// A clear medium.
+    pub const NONE: Scattering = Scattering {
+        per_mm: 0.0,
+        anisotropy: 0.0,
+    };
+
+    /// The reduced scattering coefficient `mu_s (1 - g)` (1/mm): what decides diffusion.
+    pub fn reduced_per_mm(&self) -> f64 {
+        self.per_mm * (1.0 - self.anisotropy)
+    }
 }
 
 /// The two media either side of a dielectric face.
@@ -46,7 +99,46 @@ pub struct MediumSpec {
     /// Beer-Lambert absorption coefficient (1/mm).
     #[serde(default)]
     pub absorption_per_mm: f64,
+    /// Scattering coefficient mu_s (1/mm).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub scattering_per_mm: f64,
+    /// Henyey-Greenstein anisotropy g in (-1, 1).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub anisotropy: f64,
+    /// Scattering particles (instead of `scattering_per_mm` and `anisotropy`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub particles: Option<ParticlesSpec>,
 }
+
+/// `particles = { ... }`: spheres of one size dispersed in the medium (see [`super::mie`]).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticlesSpec {
+    /// Sphere radius (micrometres).
+    pub radius_um: f64,
+    /// Real refractive index of the particles.
+    pub n: f64,
+    /// Imaginary refractive index of the particles (absorbing if > 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub k: f64,
+    /// Fraction of the medium's volume the particles take.
+    pub volume_fraction: f64,
+    /// Vacuum wavelength the coefficients are computed at (nm).
+    #[serde(default = "default_wavelength_nm")]
+    pub wavelength_nm: f64,
+}
+
+fn default_wavelength_nm() -> f64 {
+    550.0
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Above this volume fraction particles scatter dependently (near neighbours interfere),
+/// which the independent-scattering Mie sum does not describe.
+pub const MAX_VOLUME_FRACTION: f64 = 0.1;
 
 /// The default of a face's or source's `outside`/`medium`: the ambient medium.
 pub fn air() -> String {
@@ -56,29 +148,17 @@ pub fn air() -> String {
 /// The scene's medium table from its `[media.*]` sections: air first (index 0, redefined
 /// if the file names it), then the others in name order.
 pub fn build_media(ctx: &Ctx, specs: &BTreeMap<String, MediumSpec>) -> Result<Vec<Medium>> {
-    let mut media = vec![Medium {
-        name: "air".into(),
-        n: 1.0,
-        absorption_per_mm: 0.0,
-    }];
+    let mut media = vec![Medium::clear("air", 1.0, 0.0)];
     for (name, spec) in specs {
-        let n = ctx.positive(&format!("media.{name}.n"), spec.n)?;
-        let a = ctx.finite(
-            &format!("media.{name}.absorption_per_mm"),
-            spec.absorption_per_mm,
-        )?;
-        if a < 0.0 {
-            return Err(ctx.err(
-                &format!("media.{name}.absorption_per_mm"),
-                format!("must be >= 0, got {a}"),
-            ));
-        }
-        let m = Medium {
-            name: name.clone(),
-            n,
-            absorption_per_mm: a,
-        };
+        let m = spec.build(ctx, name)?;
         if name == "air" {
+            if m.scattering.per_mm > 0.0 {
+                return Err(ctx.err(
+                    "media.air",
+                    "the ambient medium is unbounded and cannot scatter \
+                     (a photon in it would never leave); scatter in a closed solid",
+                ));
+            }
             media[0] = m;
         } else {
             media.push(m);
@@ -88,6 +168,87 @@ pub fn build_media(ctx: &Ctx, specs: &BTreeMap<String, MediumSpec>) -> Result<Ve
         return Err(ctx.err("media", "too many media"));
     }
     Ok(media)
+}
+
+impl MediumSpec {
+    /// The checked medium `name`.
+    fn build(&self, ctx: &Ctx, name: &str) -> Result<Medium> {
+        let field = |f: &str| format!("media.{name}.{f}");
+        let n = ctx.positive(&field("n"), self.n)?;
+        let mut absorption =
+            ctx.non_negative(&field("absorption_per_mm"), self.absorption_per_mm)?;
+        let mu_s = ctx.non_negative(&field("scattering_per_mm"), self.scattering_per_mm)?;
+        let g = ctx.finite(&field("anisotropy"), self.anisotropy)?;
+        if g.abs() >= 1.0 {
+            return Err(ctx.err(
+                &field("anisotropy"),
+                format!("must be within (-1, 1), got {g}"),
+            ));
+        }
+        let mut scattering = Scattering {
+            per_mm: mu_s,
+            anisotropy: g,
+        };
+        if let Some(p) = &self.particles {
+            if mu_s != 0.0 || g != 0.0 {
+                return Err(ctx.err(
+                    &field("particles"),
+                    "give either particles or scattering_per_mm and anisotropy, not both",
+                ));
+            }
+            let bulk = p.bulk(ctx, &field("particles"), n)?;
+            absorption += bulk.absorption_per_mm;
+            scattering = Scattering {
+                per_mm: bulk.scattering_per_mm,
+                anisotropy: bulk.anisotropy,
+            };
+        }
+        Ok(Medium {
+            name: name.to_string(),
+            n,
+            absorption_per_mm: absorption,
+            scattering,
+            particles: self.particles.clone(),
+        })
+    }
+}
+
+impl ParticlesSpec {
+    /// The checked particles' bulk coefficients in a host of index `n_host`.
+    fn bulk(&self, ctx: &Ctx, field: &str, n_host: f64) -> Result<super::mie::Bulk> {
+        let f = |s: &str| format!("{field}.{s}");
+        let r = ctx.positive(&f("radius_um"), self.radius_um)?;
+        if r > 1e4 {
+            return Err(ctx.err(
+                &f("radius_um"),
+                format!("must be at most 1e4 um (10 mm), got {r}"),
+            ));
+        }
+        let n_p = ctx.positive(&f("n"), self.n)?;
+        let k_p = ctx.non_negative(&f("k"), self.k)?;
+        let fv = ctx.positive(&f("volume_fraction"), self.volume_fraction)?;
+        if fv > MAX_VOLUME_FRACTION {
+            return Err(ctx.err(
+                &f("volume_fraction"),
+                format!(
+                    "must be at most {MAX_VOLUME_FRACTION} (beyond it particles scatter \
+                     dependently, which the Mie sum does not describe), got {fv}"
+                ),
+            ));
+        }
+        let wl = ctx.positive(&f("wavelength_nm"), self.wavelength_nm)?;
+        let x = 2.0 * std::f64::consts::PI * r * 1e3 * n_host / wl;
+        if x > 2e4 {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "size parameter 2 pi r n / lambda = {x:.0} is beyond 2e4: \
+                     geometric optics, not Mie, describes such particles"
+                ),
+            ));
+        }
+        Ok(super::mie::bulk(r, n_p, k_p, fv, wl, n_host))
+    }
 }
 
 /// The id of the medium named `name` (given at `field`).

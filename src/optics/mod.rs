@@ -6,7 +6,8 @@
 //! [`grooves`] (procedural V-grooves and prism films, traced exactly in their layer),
 //! [`diffuser`] (rough diffusing faces), [`phong`], [`lambert`], [`mirror`] and
 //! [`absorber`]; [`surface`] joins them into the per-tag model and its Russian roulette.
-//! Shared by several: [`medium`] (media and interfaces), [`fresnel`] (Fresnel equations
+//! Shared by several: [`medium`] (media and interfaces; volume scattering with
+//! [`phase`] and [`mie`]), [`fresnel`] (Fresnel equations
 //! and roulette), [`sampling`] (direction sampling) and [`density`] (values graded along
 //! a guide).
 
@@ -20,7 +21,9 @@ pub mod fresnel;
 pub mod grooves;
 pub mod lambert;
 pub mod medium;
+pub mod mie;
 pub mod mirror;
+pub mod phase;
 pub mod phong;
 pub mod sampling;
 pub mod surface;

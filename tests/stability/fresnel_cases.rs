@@ -147,16 +147,8 @@ pub(super) fn fresnel_critical() -> Row {
 /// Media table: air and one medium of index `n`.
 pub(super) fn two_media(n: f64) -> Vec<Medium> {
     vec![
-        Medium {
-            name: "air".into(),
-            n: 1.0,
-            absorption_per_mm: 0.0,
-        },
-        Medium {
-            name: "glass".into(),
-            n,
-            absorption_per_mm: 0.0,
-        },
+        Medium::clear("air", 1.0, 0.0),
+        Medium::clear("glass", n, 0.0),
     ]
 }
 

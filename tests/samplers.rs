@@ -11,6 +11,7 @@
 
 use blutrace::optics::diffuser::sample_visible_normal;
 use blutrace::optics::fresnel;
+use blutrace::optics::phase;
 use blutrace::optics::phong::Phong;
 use blutrace::optics::sampling;
 use blutrace::rng::PhotonRng;
@@ -380,6 +381,45 @@ fn measured_led_directions_follow_the_intensity_profile() {
             },
             &pdf,
             16,
+        );
+    }
+}
+
+#[test]
+fn henyey_greenstein_directions_follow_the_phase_function_with_mean_cosine_g() {
+    // Scattering about a tilted travel direction. The cos theta edges crowd towards the
+    // forward direction (1 - cos theta = 2 (i/n)^3) so that the g = 0.9 peak, about 0.006
+    // wide in cos theta, spans several rows.
+    let axis = tilted_axis();
+    let n_cos = 30;
+    let cos_edges = (0..=n_cos)
+        .rev()
+        .map(|i| 1.0 - 2.0 * (i as f64 / n_cos as f64).powi(3))
+        .collect();
+    let grid = Grid {
+        axis,
+        cos_edges,
+        n_phi: 8,
+    };
+    for g in [-0.5, 0.0, 0.9] {
+        let draw = |i| {
+            let (u1, u2) = uniforms(41, i);
+            phase::scatter(axis, g, u1, u2)
+        };
+        assert_fits(
+            &format!("Henyey-Greenstein g = {g}"),
+            &grid,
+            &mut |i| Some(draw(i)),
+            &|w: DVec3| phase::hg_density(g, w.dot(axis)),
+            16,
+        );
+        // The mean cosine is g; the variance of cos theta is (1 - g^2) / 3 (the second
+        // Legendre moment of the phase function is g^2).
+        let mean = (0..N).map(|i| draw(i).dot(axis)).sum::<f64>() / N as f64;
+        let stderr = ((1.0 - g * g) / 3.0 / N as f64).sqrt();
+        assert!(
+            (mean - g).abs() < 4.0 * stderr,
+            "g = {g}: mean cosine {mean:.5} (stderr {stderr:.1e})"
         );
     }
 }

@@ -53,13 +53,13 @@ pub fn efficiencies(m: Complex64, x: f64) -> Efficiencies {
     let mut xi1 = Complex64::new(psi1, -chi1);
     let (mut qsca, mut qext, mut gsum) = (0.0, 0.0, 0.0);
     let (mut a_prev, mut b_prev) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
-    for n in 1..=nstop {
+    for (n, &dn) in d.iter().enumerate().take(nstop + 1).skip(1) {
         let nf = n as f64;
         let psi = (2.0 * nf - 1.0) * psi1 / x - psi0;
         let chi = (2.0 * nf - 1.0) * chi1 / x - chi0;
         let xi = Complex64::new(psi, -chi);
-        let da = d[n] / m + nf / x;
-        let db = d[n] * m + nf / x;
+        let da = dn / m + nf / x;
+        let db = dn * m + nf / x;
         let a = (da * psi - psi1) / (da * xi - xi1);
         let b = (db * psi - psi1) / (db * xi - xi1);
         let w = 2.0 * nf + 1.0;

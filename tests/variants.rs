@@ -337,9 +337,9 @@ fn phone_led_shows_hot_spots_and_dark_corners() {
 fn direct_lit_more_lamps_are_more_uniform() {
     let n = 200_000;
     let mut rows = Vec::new();
+    // The rough-plate variants: the bundled scene's bulk plate is another model.
     for (rel, lamps) in [
         ("test/direct-lit-3/scene.toml", 3),
-        ("direct-lit/scene.toml", 6),
         ("test/direct-lit-8/scene.toml", 8),
     ] {
         let scene = load_bundled(rel);
@@ -377,6 +377,37 @@ fn direct_lit_more_lamps_are_more_uniform() {
             "{na} lamps: cv {cva:.4} +- {sea:.4}; {nb} lamps: cv {cvb:.4} +- {seb:.4}"
         );
     }
+}
+
+#[test]
+fn bundled_direct_lit_has_a_bulk_diffuser_plate() {
+    let scene = load_bundled("direct-lit/scene.toml");
+    assert_eq!(scene.sources.list.len(), 6);
+    let pc = scene.media.iter().find(|m| m.name == "pc").unwrap();
+    assert!(
+        pc.particles.is_some(),
+        "the plate's scattering comes from its beads"
+    );
+    assert!(pc.scattering.per_mm > 1.0 && pc.scattering.anisotropy > 0.9);
+    for face in ["diffuser_top", "diffuser_back"] {
+        let t = scene.tags.iter().position(|t| t == face).unwrap();
+        assert_eq!(
+            scene.surfaces[t].kind(),
+            "dielectric",
+            "{face}: smooth face"
+        );
+    }
+    let pc_id = scene.media.iter().position(|m| m.name == "pc").unwrap() as u16;
+    assert!(
+        scene.convex_solid(pc_id).is_some(),
+        "the plate takes the convex path"
+    );
+    let r = trace(&scene, 4096, 3, 2);
+    assert_balanced(&r);
+    assert!(
+        r.tally.ledger.interactions > 50 * 4096,
+        "light scatters in the plate"
+    );
 }
 
 // ---------------------------------------------------------------------------------------

@@ -40,8 +40,16 @@ pub const LAMP_POWER_W: f64 = 1.0;
 pub const WALL_ALBEDO: f64 = 0.95;
 /// Detector height above the diffuser plate's top face (mm).
 pub const DETECTOR_GAP: f64 = 0.5;
-/// Default GGX roughness (alpha) of the diffuser plate's two large faces.
+/// Default GGX roughness (alpha) of the diffuser plate's two large faces (rough plate).
 pub const DIFFUSER_ROUGHNESS: f64 = 0.6;
+/// Bulk plate: radius of the diffusing beads (um): Momentive TSR9000 (polymethyl-
+/// silsesquioxane spheres, the Tospearl family), mean diameter 2.0 um.
+pub const BEAD_RADIUS_UM: f64 = 1.0;
+/// Bulk plate: the beads' refractive index (TSR9000: 1.42).
+pub const BEAD_N: f64 = 1.42;
+/// Bulk plate: the beads' volume fraction, a design choice: 1 % by volume is 1.1 % by
+/// weight at the beads' specific gravity (TSR9000: 1.32) in PC (1.20).
+pub const BEAD_VOLUME_FRACTION: f64 = 0.01;
 /// The geometry file's name in every variant's folder.
 pub const OBJ: &str = "direct-lit.obj";
 /// Its display-material library.
@@ -60,6 +68,20 @@ pub enum Reflector {
     },
 }
 
+/// The diffuser plate's model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Plate {
+    /// A bulk diffuser: PC filled with beads ([`BEAD_RADIUS_UM`], [`BEAD_N`],
+    /// [`BEAD_VOLUME_FRACTION`]), mu_s and g from Mie theory, smooth faces.
+    Bulk,
+    /// A clear PC plate whose two large faces are rough (model `diffuser`, GGX roughness
+    /// `roughness`; 0 is a clear plate): a surface-scattering stand-in for a bulk plate.
+    Rough {
+        /// GGX alpha.
+        roughness: f64,
+    },
+}
+
 /// The parameters of a direct-lit box.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DirectLit {
@@ -73,9 +95,8 @@ pub struct DirectLit {
     pub lamp_height: f64,
     /// Back reflector shape.
     pub reflector: Reflector,
-    /// GGX roughness of the diffuser plate's two large faces (model `diffuser`; 0 is a
-    /// clear plate).
-    pub diffuser_roughness: f64,
+    /// The diffuser plate's model.
+    pub plate: Plate,
     /// Flux bins (x, y).
     pub bins: [usize; 2],
     /// Default photon count.
@@ -84,14 +105,17 @@ pub struct DirectLit {
 
 impl DirectLit {
     /// The bundled `direct-lit` scene: 6 lamps at the box's natural pitch (`BOX_X / 6`),
-    /// 8 mm up, over 6 mm ridges.
+    /// 8 mm up, over 6 mm ridges, under a bulk diffuser plate.
     pub fn bundled() -> Self {
-        Self::evenly_spaced("direct-lit", 6)
+        Self {
+            plate: Plate::Bulk,
+            ..Self::evenly_spaced("direct-lit", 6)
+        }
     }
 
     /// `lamps` lamps spaced `BOX_X / lamps` (each owns an equal strip of the box), 8 mm
-    /// up, over 6 mm ridges, under a plate of roughness [`DIFFUSER_ROUGHNESS`]; 80 x 50
-    /// bins of 5 mm.
+    /// up, over 6 mm ridges, under a rough plate of roughness [`DIFFUSER_ROUGHNESS`];
+    /// 80 x 50 bins of 5 mm.
     pub fn evenly_spaced(name: &str, lamps: usize) -> Self {
         Self {
             name: name.to_string(),
@@ -99,7 +123,9 @@ impl DirectLit {
             pitch: BOX_X / lamps as f64,
             lamp_height: 8.0,
             reflector: Reflector::Ridges { height: 6.0 },
-            diffuser_roughness: DIFFUSER_ROUGHNESS,
+            plate: Plate::Rough {
+                roughness: DIFFUSER_ROUGHNESS,
+            },
             bins: [80, 50],
             photons: 400_000,
         }
@@ -151,11 +177,10 @@ impl DirectLit {
         if self.lamps == 0 {
             return Err("needs at least one lamp".into());
         }
-        if !(self.diffuser_roughness >= 0.0 && self.diffuser_roughness.is_finite()) {
-            return Err(format!(
-                "diffuser roughness {}: must be >= 0",
-                self.diffuser_roughness
-            ));
+        if let Plate::Rough { roughness } = self.plate
+            && !(roughness >= 0.0 && roughness.is_finite())
+        {
+            return Err(format!("diffuser roughness {roughness}: must be >= 0"));
         }
         let pitch_ok = self.pitch.is_finite() && self.pitch > 2.0 * LAMP_R + 1.0;
         if self.lamps > 1 && !pitch_ok {
@@ -275,9 +300,7 @@ Axes (mm): x across the lamps, y along them, z towards the viewer.
   x = {xs}.
 - Diffuser plate: polycarbonate (n = {N_PLATE}, absorption {PLATE_ABSORPTION} /mm), {BOX_X} x {BOX_Y} x {PLATE_T}
   at z = {DEPTH}..{ztop}, resting on the walls. Tags diffuser_top (the front face),
-  diffuser_back, diffuser_edge (smooth). Its two large faces are rough dielectric
-  interfaces (model diffuser, GGX roughness {rough}): a surface-scattering stand-in for a
-  bulk-diffusing plate, which blutrace cannot model (no volume scattering).
+  diffuser_back, diffuser_edge (smooth). {plate}
 - Detector: {DETECTOR_GAP} above the plate (z = {zd}), covering it, {bx} x {by} bins.
 
 Geometry: {obj} (tags are its usemtl names), {triangles} triangles.
@@ -289,7 +312,7 @@ Geometry: {obj} (tags are its usemtl names), {triangles} triangles.
             xs = xs.join(", "),
             pitch = dim(self.pitch),
             ztop = dim(DEPTH + PLATE_T),
-            rough = num(self.diffuser_roughness),
+            plate = self.plate_note(),
             zd = dim(DEPTH + PLATE_T + DETECTOR_GAP),
             bx = self.bins[0],
             by = self.bins[1],
@@ -307,22 +330,16 @@ file = \"{obj}\"
 
 [media.pc]
 n = {np}
-absorption_per_mm = {PLATE_ABSORPTION}
+absorption_per_mm = {PLATE_ABSORPTION}{particles}
 
 [surfaces.box_reflector]
 model = \"lambert\"
 albedo = {WALL_ALBEDO}
 
 [surfaces.diffuser_top]
-model = \"diffuser\"
-inside = \"pc\"
-roughness = {rough}
-
+{face}
 [surfaces.diffuser_back]
-model = \"diffuser\"
-inside = \"pc\"
-roughness = {rough}
-
+{face}
 [surfaces.diffuser_edge]
 model = \"dielectric\"
 inside = \"pc\"
@@ -332,7 +349,22 @@ inside = \"pc\"
             pitch = dim(self.pitch),
             obj = OBJ,
             np = num(N_PLATE),
-            rough = num(self.diffuser_roughness),
+            particles = match self.plate {
+                Plate::Bulk => format!(
+                    "\nparticles = {{ radius_um = {}, n = {}, volume_fraction = {}, wavelength_nm = 550.0 }}",
+                    num(BEAD_RADIUS_UM),
+                    num(BEAD_N),
+                    num(BEAD_VOLUME_FRACTION)
+                ),
+                Plate::Rough { .. } => String::new(),
+            },
+            face = match self.plate {
+                Plate::Bulk => "model = \"dielectric\"\ninside = \"pc\"\n".to_string(),
+                Plate::Rough { roughness } => format!(
+                    "model = \"diffuser\"\ninside = \"pc\"\nroughness = {}\n",
+                    num(roughness)
+                ),
+            },
         );
         for (i, c) in self.lamp_centres().iter().enumerate() {
             s += &format!(
@@ -371,6 +403,35 @@ angular_bins = [18, 36]
             trace_table(self.photons, 100_000)
         );
         s
+    }
+
+    /// The plate's paragraph in the scene file's header.
+    fn plate_note(&self) -> String {
+        match self.plate {
+            Plate::Bulk => format!(
+                "A bulk diffuser
+  (volume scattering, smooth faces): spheres of radius {r} um and index {nb}
+  (Momentive TSR9000 polymethylsilsesquioxane beads: mean diameter 2.0 um, refractive
+  index 1.42, specific gravity 1.32, ChemPoint product page \"Momentive TSR9000 for
+  Light Diffusion\") at {fv} by volume (a design choice: {wt:.1} % by weight in PC of
+  specific gravity 1.20). blutrace computes mu_s and g from Mie theory at 550 nm
+  (blutrace check shows them: about 20.4 /mm and 0.978). Stand-in limits: one bead
+  size (real beads have a size spread), the Henyey-Greenstein phase function with the
+  Mie g (not the full Mie phase function), independent scattering, one wavelength.
+  The rough-surface model (diffuser, GGX) stays available: see the scenegen parameters.",
+                r = num(BEAD_RADIUS_UM),
+                nb = num(BEAD_N),
+                fv = num(BEAD_VOLUME_FRACTION),
+                wt = 100.0 * (BEAD_VOLUME_FRACTION * 1.32)
+                    / (BEAD_VOLUME_FRACTION * 1.32 + (1.0 - BEAD_VOLUME_FRACTION) * 1.20),
+            ),
+            Plate::Rough { roughness } => format!(
+                "Its two large faces are rough
+  dielectric interfaces (model diffuser, GGX roughness {}): a surface-scattering
+  stand-in for a bulk-diffusing plate (the bundled direct-lit scene has the bulk one).",
+                num(roughness)
+            ),
+        }
     }
 
     /// The scene's files below `folder` (e.g. `direct-lit` or `test/direct-lit-3`):

@@ -524,3 +524,78 @@ fn cad_reflector_gltf_and_obj_exports_agree() {
         "reflector absorbs {ra:.5} vs {rb:.5}"
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// diffusion-lgp
+
+/// The flux profile of a diffusion-lgp run along the guide: `segments` equal lengths
+/// from the lamp, each the mean over the map's bins (across the whole width), relative to
+/// the mean of all, with the run's extraction efficiency.
+fn diffusion_profile(rel: &str, photons: u64, segments: usize) -> (Vec<f64>, f64) {
+    let scene = load_bundled(rel);
+    let r = trace_opts(
+        &scene,
+        &blutrace::run::RunOptions {
+            photons,
+            seed: 5,
+            threads: Some(2),
+            estimator: blutrace::optics::surface::Estimator::Weighted,
+            ..blutrace::run::RunOptions::default()
+        },
+    );
+    assert_balanced(&r);
+    let m = r.flux_map();
+    assert_eq!(m.nx % segments, 0);
+    let per = m.nx / segments;
+    let seg: Vec<f64> = (0..segments)
+        .map(|s| {
+            let cols = s * per..(s + 1) * per;
+            let sum: f64 = (0..m.ny)
+                .flat_map(|y| cols.clone().map(move |x| y * m.nx + x))
+                .map(|i| m.value[i])
+                .sum();
+            sum / (per * m.ny) as f64
+        })
+        .collect();
+    let mean = seg.iter().sum::<f64>() / segments as f64;
+    let eff = r.summary().extraction_efficiency;
+    (seg.iter().map(|v| v / mean).collect(), eff)
+}
+
+const DIFFUSION_LOADS: [&str; 3] = [
+    "diffusion-lgp/scene-light.toml",
+    "diffusion-lgp/scene.toml",
+    "diffusion-lgp/scene-heavy.toml",
+];
+
+#[test]
+fn diffusion_lgp_more_beads_extract_more_and_nearer_the_lamp() {
+    // No dots: the beads alone extract. More beads: more light out, and the profile
+    // tilts towards the lamp (first quarter over last quarter grows).
+    let mut last: Option<(f64, f64)> = None;
+    for rel in DIFFUSION_LOADS {
+        let (p, eff) = diffusion_profile(rel, 40_960, 4);
+        let tilt = p[0] / p[3];
+        println!("{rel}: efficiency {eff:.3}, first/last quarter {tilt:.2}");
+        if let Some((e0, t0)) = last {
+            assert!(eff > e0 + 0.03, "{rel}: efficiency {eff:.3} after {e0:.3}");
+            assert!(tilt > t0, "{rel}: tilt {tilt:.2} after {t0:.2}");
+        }
+        last = Some((eff, tilt));
+    }
+}
+
+/// The README's diffusion-lgp table: `cargo test --release --test variants --
+/// --ignored diffusion_lgp_profile_table --nocapture`.
+#[test]
+#[ignore]
+fn diffusion_lgp_profile_table() {
+    println!(
+        "| load | efficiency | 0-25 | 25-50 | 50-75 | 75-100 | 100-125 | 125-150 | 150-175 | 175-200 mm |"
+    );
+    for rel in DIFFUSION_LOADS {
+        let (p, eff) = diffusion_profile(rel, 2_000_000, 8);
+        let cells: Vec<String> = p.iter().map(|v| format!("{v:.2}")).collect();
+        println!("| {rel} | {eff:.3} | {} |", cells.join(" | "));
+    }
+}

@@ -3,7 +3,7 @@
 # and the bench table. Results are deterministic (fixed seeds); only the timings depend on
 # the machine and its load, so run it on a quiet machine.
 #
-#   bash tools/readme-figures.sh [gallery|optimize|bench|bodies|placement|all]   (default: all)
+#   bash tools/readme-figures.sh [gallery|optimize|volume|bench|bodies|placement|all]   (default: all)
 #
 # Logs go to out/figures/*.log; the README tables are filled in from them by hand.
 set -euo pipefail
@@ -23,7 +23,7 @@ timed() {
 }
 
 gallery() {
-  for s in notebook14 wedge-ccfl phone-led direct-lit cad-reflector bef-stack; do
+  for s in notebook14 wedge-ccfl phone-led direct-lit cad-reflector bef-stack diffusion-lgp; do
     "$bin" trace "scenes/$s" --photons 1000000 --estimator weighted --quiet \
       --out "$out/$s" >"$out/$s.log"
     cp "$out/$s/flux.png" "docs/img/$s-flux.png"
@@ -78,6 +78,12 @@ placement() {
     table table_guide grooves_table >"$out/placement.log" 2>&1
 }
 
+volume() {
+  # The diffusion-lgp profile table (README, "Diffusion light guides").
+  cargo test --release -q --test variants -- --ignored diffusion_lgp_profile_table \
+    --nocapture >"$out/diffusion-lgp-profile.log" 2>&1
+}
+
 bench() {
   "$bin" bench --photons 200000 >"$out/bench.log" 2>&1
 }
@@ -85,9 +91,10 @@ bench() {
 case "$what" in
   gallery) gallery ;;
   optimize) optimize ;;
+  volume) volume ;;
   bench) bench ;;
   bodies) bodies ;;
   placement) placement ;;
-  all) gallery; bodies; optimize; placement; bench ;;
-  *) echo "usage: $0 [gallery|optimize|bench|bodies|placement|all]" >&2; exit 2 ;;
+  all) gallery; bodies; optimize; placement; volume; bench ;;
+  *) echo "usage: $0 [gallery|optimize|volume|bench|bodies|placement|all]" >&2; exit 2 ;;
 esac

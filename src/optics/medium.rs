@@ -281,3 +281,33 @@ impl Interface {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn a_scattering_medium_survives_a_toml_round_trip() {
+        // The optimizer writes scenes back (optimized.toml): particles and coefficients
+        // must come back unchanged, and a clear medium must not grow new keys.
+        let text = "[a]\nn = 1.49\nparticles = { radius_um = 1.0, n = 1.42, volume_fraction = 0.001 }\n\
+                    [b]\nn = 1.585\nscattering_per_mm = 4.0\nanisotropy = 0.9\n[c]\nn = 1.5\n";
+        let specs: BTreeMap<String, MediumSpec> = toml::from_str(text).unwrap();
+        let again: BTreeMap<String, MediumSpec> =
+            toml::from_str(&toml::to_string(&specs).unwrap()).unwrap();
+        let ctx = Ctx(Path::new("scene.toml"));
+        assert_eq!(
+            build_media(&ctx, &specs).unwrap(),
+            build_media(&ctx, &again).unwrap()
+        );
+        let clear = toml::to_string(&specs["c"]).unwrap();
+        assert!(
+            !clear.contains("scattering") && !clear.contains("anisotropy"),
+            "{clear}"
+        );
+        let media = build_media(&ctx, &specs).unwrap();
+        assert_eq!(media[2].scattering.per_mm, 4.0);
+        assert_eq!(media[1].particles.as_ref().unwrap().wavelength_nm, 550.0);
+    }
+}

@@ -423,3 +423,78 @@ fn henyey_greenstein_directions_follow_the_phase_function_with_mean_cosine_g() {
         );
     }
 }
+
+#[test]
+fn tabulated_phase_function_directions_follow_the_table() {
+    // A forward peak with a weak backward lobe, linear between knots (per steradian).
+    let rows = [
+        [0.0, 10.0],
+        [5.0, 6.0],
+        [20.0, 1.0],
+        [60.0, 0.2],
+        [120.0, 0.1],
+        [170.0, 0.5],
+        [180.0, 0.6],
+    ];
+    let table = phase::PhaseTable::new(&rows).unwrap();
+    // The expected density, from the rows alone: linear in the angle, normalized here.
+    let raw = |th: f64| {
+        let deg = th.to_degrees();
+        let i = rows
+            .iter()
+            .position(|r| r[0] >= deg)
+            .unwrap_or(rows.len() - 1)
+            .max(1);
+        let ([a0, v0], [a1, v1]) = (rows[i - 1], rows[i]);
+        v0 + (v1 - v0) * ((deg - a0) / (a1 - a0)).clamp(0.0, 1.0)
+    };
+    let n = 200_000;
+    let norm: f64 = (0..n)
+        .map(|i| {
+            let th = (i as f64 + 0.5) * PI / n as f64;
+            TAU * raw(th) * th.sin() * PI / n as f64
+        })
+        .sum();
+    let mean: f64 = (0..n)
+        .map(|i| {
+            let th = (i as f64 + 0.5) * PI / n as f64;
+            TAU * raw(th) * th.sin() * th.cos() * PI / n as f64
+        })
+        .sum::<f64>()
+        / norm;
+    assert!(
+        (table.mean_cosine - mean).abs() < 1e-5,
+        "{} vs {mean}",
+        table.mean_cosine
+    );
+    let axis = tilted_axis();
+    let n_cos = 30;
+    let grid = Grid {
+        axis,
+        cos_edges: (0..=n_cos)
+            .rev()
+            .map(|i| 1.0 - 2.0 * (i as f64 / n_cos as f64).powi(2))
+            .collect(),
+        n_phi: 8,
+    };
+    assert_fits(
+        "phase table",
+        &grid,
+        &mut |i| {
+            let (u1, u2) = uniforms(43, i);
+            Some(sampling::around(axis, table.cos_theta(u1), TAU * u2))
+        },
+        &|w: DVec3| raw(w.dot(axis).clamp(-1.0, 1.0).acos()) / norm,
+        16,
+    );
+    for bad in [
+        vec![[0.0, 1.0]],
+        vec![[0.0, 1.0], [90.0, 1.0]],
+        vec![[0.0, 1.0], [90.0, -1.0], [180.0, 1.0]],
+        vec![[0.0, 1.0], [90.0, 1.0], [90.0, 1.0], [180.0, 1.0]],
+        vec![[0.0, 0.0], [180.0, 0.0]],
+        vec![[0.0, f64::NAN], [180.0, 1.0]],
+    ] {
+        assert!(phase::PhaseTable::new(&bad).is_err(), "{bad:?}");
+    }
+}

@@ -46,8 +46,13 @@ fn scattering(m: &Medium) -> String {
         ),
         None => String::new(),
     };
+    let phase = if s.table.is_some() {
+        "measured phase function, mean cosine"
+    } else {
+        "anisotropy g ="
+    };
     format!(
-        ", scattering {:.6} /mm, anisotropy g = {:.4}, reduced {:.6} /mm{from}",
+        ", scattering {:.6} /mm, {phase} {:.4}, reduced {:.6} /mm{from}",
         s.per_mm,
         s.anisotropy,
         s.reduced_per_mm()
@@ -62,6 +67,7 @@ fn medium_json(m: &Medium) -> serde_json::Value {
         "absorption_per_mm": m.absorption_per_mm,
         "scattering_per_mm": m.scattering.per_mm,
         "anisotropy": m.scattering.anisotropy,
+        "phase_table": m.scattering.table.is_some(),
         "particles": m.particles,
     })
 }

@@ -11,6 +11,11 @@
 //! scattering_per_mm = 4.0      # mu_s, 1/mm (default 0: clear)
 //! anisotropy = 0.9             # Henyey-Greenstein g in (-1, 1) (default 0: isotropic)
 //!
+//! [media.measured]             # or a measured phase function instead of g
+//! n = 1.49
+//! scattering_per_mm = 0.5
+//! phase_table = [[0.0, 10.0], [10.0, 2.0], [90.0, 0.05], [180.0, 0.02]]  # [deg, per sr]
+//!
 //! [media.diffusion_pmma]       # or mu_s and g from particles (Mie, see `mie`)
 //! n = 1.49
 //! particles = { radius_um = 2.0, n = 1.43, volume_fraction = 0.001, wavelength_nm = 550.0 }
@@ -22,10 +27,15 @@
 //! (free paths, scattering events) is the tracer's (`tracer::flight`); the phase
 //! function is [`super::phase`].
 
+use super::phase::{self, PhaseTable};
+use super::sampling;
 use crate::spec_check::Ctx;
 use anyhow::Result;
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::f64::consts::TAU;
+use std::sync::Arc;
 
 /// Index of a medium in the scene's medium table (0 is the ambient medium, air).
 pub type MediumId = u16;
@@ -59,13 +69,15 @@ impl Medium {
 }
 
 /// Volume scattering: free paths of mean `1 / per_mm` between events, and the phase
-/// function's anisotropy.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// function: Henyey-Greenstein with the anisotropy, or a measured table.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Scattering {
     /// Scattering coefficient mu_s (1/mm); 0 = clear.
     pub per_mm: f64,
-    /// Henyey-Greenstein anisotropy g, the mean cosine of the scattering angle.
+    /// The mean cosine of the scattering angle: the Henyey-Greenstein g, or the table's.
     pub anisotropy: f64,
+    /// A measured phase function, used instead of Henyey-Greenstein.
+    pub table: Option<Arc<PhaseTable>>,
 }
 
 impl Scattering {
@@ -73,7 +85,17 @@ impl Scattering {
     pub const NONE: Scattering = Scattering {
         per_mm: 0.0,
         anisotropy: 0.0,
+        table: None,
     };
+
+    /// The direction after scattering a photon travelling along unit `dir`, from two
+    /// uniform numbers.
+    pub fn scatter(&self, dir: DVec3, u1: f64, u2: f64) -> DVec3 {
+        match &self.table {
+            Some(t) => sampling::around(dir, t.cos_theta(u1), TAU * u2),
+            None => phase::scatter(dir, self.anisotropy, u1, u2),
+        }
+    }
 
     /// The reduced scattering coefficient `mu_s (1 - g)` (1/mm): what decides diffusion.
     pub fn reduced_per_mm(&self) -> f64 {
@@ -105,6 +127,10 @@ pub struct MediumSpec {
     /// Henyey-Greenstein anisotropy g in (-1, 1).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub anisotropy: f64,
+    /// A measured phase function, `[angle_deg, value per steradian]` rows from 0 to 180
+    /// degrees (instead of `anisotropy`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase_table: Option<Vec<[f64; 2]>>,
     /// Scattering particles (instead of `scattering_per_mm` and `anisotropy`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub particles: Option<ParticlesSpec>,
@@ -188,7 +214,20 @@ impl MediumSpec {
         let mut scattering = Scattering {
             per_mm: mu_s,
             anisotropy: g,
+            table: None,
         };
+        if let Some(rows) = &self.phase_table {
+            let f = field("phase_table");
+            if g != 0.0 || self.particles.is_some() {
+                return Err(ctx.err(&f, "replaces anisotropy and particles: give one of them"));
+            }
+            if mu_s == 0.0 {
+                return Err(ctx.err(&f, "needs scattering_per_mm > 0"));
+            }
+            let t = PhaseTable::new(rows).map_err(|e| ctx.err(&f, e))?;
+            scattering.anisotropy = t.mean_cosine;
+            scattering.table = Some(Arc::new(t));
+        }
         if let Some(p) = &self.particles {
             if mu_s != 0.0 || g != 0.0 {
                 return Err(ctx.err(
@@ -201,6 +240,7 @@ impl MediumSpec {
             scattering = Scattering {
                 per_mm: bulk.scattering_per_mm,
                 anisotropy: bulk.anisotropy,
+                table: None,
             };
         }
         Ok(Medium {

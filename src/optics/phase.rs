@@ -4,6 +4,10 @@
 //! `p(cos theta) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos theta)^(3/2))` per steradian, with
 //! mean cosine `g` (the anisotropy): 0 isotropic, towards 1 forward, towards -1 backward.
 //! Sampled by inverting its cumulative distribution in `cos theta` (exact, no rejection).
+//!
+//! Or a measured phase function, `phase_table = [[angle_deg, value], ...]` ([`PhaseTable`]):
+//! values per steradian (any scale) at scattering angles from 0 to 180 degrees, linear
+//! between knots.
 
 use super::sampling;
 use glam::DVec3;
@@ -32,6 +36,99 @@ pub fn hg_cos_theta(g: f64, u: f64) -> f64 {
 /// numbers: polar angle from the phase function, azimuth uniform.
 pub fn scatter(dir: DVec3, g: f64, u1: f64, u2: f64) -> DVec3 {
     sampling::around(dir, hg_cos_theta(g, u1), TAU * u2)
+}
+
+/// Fine cells over 0..180 degrees for sampling a [`PhaseTable`]: the density is taken as
+/// constant in theta within a cell of 0.044 degrees, far finer than any measured table.
+const TABLE_CELLS: usize = 4096;
+
+/// A tabulated phase function: value per steradian, piecewise linear in the scattering
+/// angle, normalized; sampled by inverse CDF over fine cells in theta.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhaseTable {
+    /// Knots: angle (radians), value (per steradian, normalized to integrate to 1).
+    knots: Vec<(f64, f64)>,
+    /// Cumulative probability at the fine cells' edges (`TABLE_CELLS + 1`, from 0 to 1).
+    cdf: Vec<f64>,
+    /// The mean cosine of the scattering angle.
+    pub mean_cosine: f64,
+}
+
+impl PhaseTable {
+    /// From `[angle_deg, value]` rows: angles strictly increasing from 0 to 180, values
+    /// finite and >= 0, not all 0. `Err` says what is wrong.
+    pub fn new(rows: &[[f64; 2]]) -> Result<PhaseTable, String> {
+        if rows.len() < 2 {
+            return Err("needs at least two rows, at 0 and 180 degrees".into());
+        }
+        for (i, [a, v]) in rows.iter().enumerate() {
+            if !a.is_finite() || !v.is_finite() || *v < 0.0 {
+                return Err(format!(
+                    "row {i}: angle and value must be finite, value >= 0, got [{a}, {v}]"
+                ));
+            }
+            if i > 0 && *a <= rows[i - 1][0] {
+                return Err(format!(
+                    "row {i}: angles must increase, got {a} after {}",
+                    rows[i - 1][0]
+                ));
+            }
+        }
+        if rows[0][0] != 0.0 || rows[rows.len() - 1][0] != 180.0 {
+            return Err("angles must run from 0 to 180 degrees".into());
+        }
+        let mut t = PhaseTable {
+            knots: rows.iter().map(|[a, v]| (a.to_radians(), *v)).collect(),
+            cdf: Vec::with_capacity(TABLE_CELLS + 1),
+            mean_cosine: 0.0,
+        };
+        // Per-cell probability 2 pi v(theta) sin(theta) dtheta at the cell's midpoint.
+        let d = PI / TABLE_CELLS as f64;
+        let (mut sum, mut mean) = (0.0, 0.0);
+        t.cdf.push(0.0);
+        for i in 0..TABLE_CELLS {
+            let th = (i as f64 + 0.5) * d;
+            let p = TAU * t.value(th) * th.sin() * d;
+            sum += p;
+            mean += p * th.cos();
+            t.cdf.push(sum);
+        }
+        if sum <= 0.0 {
+            return Err("the values are all 0".into());
+        }
+        t.cdf.iter_mut().for_each(|c| *c /= sum);
+        t.knots.iter_mut().for_each(|k| k.1 /= sum);
+        t.mean_cosine = mean / sum;
+        Ok(t)
+    }
+
+    /// The normalized value (per steradian) at scattering angle `theta` (radians).
+    fn value(&self, theta: f64) -> f64 {
+        let i = self
+            .knots
+            .partition_point(|k| k.0 <= theta)
+            .clamp(1, self.knots.len() - 1);
+        let ((a0, v0), (a1, v1)) = (self.knots[i - 1], self.knots[i]);
+        v0 + (v1 - v0) * ((theta - a0) / (a1 - a0)).clamp(0.0, 1.0)
+    }
+
+    /// The density per steradian at `cos_t` (as sampled: constant within a fine cell).
+    pub fn density(&self, cos_t: f64) -> f64 {
+        let d = PI / TABLE_CELLS as f64;
+        let th = cos_t.clamp(-1.0, 1.0).acos();
+        let i = ((th / d) as usize).min(TABLE_CELLS - 1);
+        let mid = (i as f64 + 0.5) * d;
+        self.value(mid) * mid.sin() / th.sin().max(1e-300)
+    }
+
+    /// `cos theta` of a draw from one uniform number `u` in `[0, 1)`: the fine cell by
+    /// the CDF, theta uniform within it.
+    pub fn cos_theta(&self, u: f64) -> f64 {
+        let i = (self.cdf.partition_point(|&c| c <= u) - 1).min(TABLE_CELLS - 1);
+        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let f = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
+        ((i as f64 + f) * PI / TABLE_CELLS as f64).cos()
+    }
 }
 
 #[cfg(test)]

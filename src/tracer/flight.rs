@@ -15,7 +15,6 @@
 
 use crate::estimator::Estimator;
 use crate::optics::medium::Medium;
-use crate::optics::phase;
 use crate::rng::PhotonRng;
 use crate::tally::{ExactSum, Ledger};
 use glam::DVec3;
@@ -84,10 +83,9 @@ pub(super) fn fly(
     } else {
         t.min(t_next * 0.5)
     };
-    let g = medium.scattering.anisotropy;
     let (u1, u2) = (rng.uniform(), rng.uniform());
     Flight::Scattered {
         t,
-        dir: phase::scatter(dir, g, u1, u2),
+        dir: medium.scattering.scatter(dir, u1, u2),
     }
 }

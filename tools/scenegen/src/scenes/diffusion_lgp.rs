@@ -6,8 +6,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num,
+    tags_of, write_mtl, write_obj,
 };
 
 /// Guide size (x along the light, y across, z thickness) (mm); it spans 0..SIZE.
@@ -202,7 +202,7 @@ axis = [0.0, 1.0, 0.0]
 radius_mm = {lr}
 length_mm = {l}
 power_w = 1.0
-
+{CCFL_BODY}
 [detector]
 origin = {o}
 u = [1.0, 0.0, 0.0]

@@ -27,8 +27,9 @@ enum Command {
     Trace(trace::TraceArgs),
     /// Merge shard runs (`trace --shard K/M`) into the outputs of one run.
     Merge(trace::MergeArgs),
-    /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback).
-    Optimize(optimize::OptimizeArgs),
+    /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback), or any
+    /// numbers of the scene file (`--vary`).
+    Optimize(Box<optimize::OptimizeArgs>),
     /// Measure photons/s per backend (ratios in one run; see the README's table).
     Bench {
         /// Photons per configuration.
@@ -92,7 +93,7 @@ impl Command {
         match self {
             Command::Trace(args) => trace::trace(args),
             Command::Merge(args) => trace::merge(args),
-            Command::Optimize(args) => optimize::run(args),
+            Command::Optimize(args) => optimize::run(*args),
             Command::Bench {
                 photons,
                 threads,

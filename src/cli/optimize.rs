@@ -3,6 +3,7 @@
 //! ```text
 //! blutrace optimize scenes/notebook14 --method feedback --photons 1000000 --target-cv 0.03
 //! blutrace optimize scenes/notebook14 --method nelder-mead --max-iter 60 --out out/nm
+//! blutrace optimize scenes/direct-lit --vary 'sources.*.center.2=4..20' --objective cv
 //! ```
 //!
 //! Prints one line per iteration (best objective with its noise, whole-map cv and 13-point
@@ -10,7 +11,10 @@
 //! first and final design with error bars, and the files written.
 
 use super::{default_out, scene_path};
-use crate::optimize::{OptimizeOptions, OptimizeResult, VerifiedDesign, optimize};
+use crate::optimize::layout::EvaluationRecord;
+use crate::optimize::{
+    LayoutResult, OptimizeOptions, OptimizeResult, VerifiedDesign, optimize, optimize_layout,
+};
 use crate::scene::Scene;
 use anyhow::Result;
 use std::path::PathBuf;
@@ -51,6 +55,9 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let options = args.options(&scene);
+    if !options.vary.is_empty() {
+        return run_layout(&scene, &options, &args);
+    }
     let out = args.out.clone().unwrap_or_else(|| {
         let suffix = if options.tunes_grid() { "-2d" } else { "" };
         default_out(&format!(
@@ -83,6 +90,98 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
         println!("wrote      {}", f.display());
     }
     Ok(())
+}
+
+/// `blutrace optimize --vary`.
+fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<()> {
+    let out = args.out.clone().unwrap_or_else(|| {
+        default_out(&format!(
+            "{}-optimize-layout-{}",
+            scene.name, options.method
+        ))
+    });
+    println!(
+        "optimize   {} ({}) by {} over {} variable(s): {} photons per design, seed {}, objective = {}",
+        scene.name,
+        scene.path.display(),
+        options.method,
+        options.vary.len(),
+        options.photons,
+        options.seed,
+        options.objective
+    );
+    let quiet = args.quiet;
+    let result = optimize_layout(scene, options, &mut |r, names| {
+        if !quiet {
+            print_evaluation(r, names);
+        }
+    })?;
+    print_layout_report(&result);
+    for f in result.write(&out)? {
+        println!("wrote      {}", f.display());
+    }
+    Ok(())
+}
+
+/// One line per evaluated design.
+fn print_evaluation(r: &EvaluationRecord, names: &[String]) {
+    let head = format!(
+        "eval {:>4}  photons {:>8.2}M  {:>6.1} s  {}",
+        r.evaluation,
+        r.photons as f64 * 1e-6,
+        r.seconds,
+        r.assignment(names)
+    );
+    match (&r.result, &r.rejected) {
+        (Some(e), _) => println!("{head}  {e}"),
+        (None, Some(why)) => println!("{head}  not traced: {why}"),
+        (None, None) => println!("{head}"),
+    }
+}
+
+/// The search's totals, each integer case, the variables and the verification.
+pub fn print_layout_report(r: &LayoutResult) {
+    println!(
+        "search     {} designs, {} photons ({:.2}M), {:.1} s",
+        r.history.len(),
+        r.photons,
+        r.photons as f64 * 1e-6,
+        r.seconds
+    );
+    if r.cases.len() > 1 {
+        for c in &r.cases {
+            println!(
+                "case       {:?}: objective {:.4} ± {:.4} ({} designs; {})",
+                c.integers, c.objective, c.noise, c.evaluations, c.termination
+            );
+        }
+    } else if let Some(c) = r.cases.first() {
+        println!("stopped    {}", c.termination);
+    }
+    println!(
+        "objective  {:.4} ± {:.4} -> {:.4} ± {:.4} (seed {}, {} photons; cv noise floor {:.4})",
+        r.initial.objective,
+        r.initial.noise,
+        r.best.objective,
+        r.best.noise,
+        r.options.seed,
+        r.options.photons,
+        r.best.noise_floor
+    );
+    for v in &r.variables {
+        println!(
+            "variable   {} = {} -> {} (range {}..{})",
+            v.name, v.initial, v.final_value, v.min, v.max
+        );
+    }
+    if let Some(v) = &r.verification {
+        println!(
+            "verify     re-traced with seed {} and {} photons:",
+            v.seed, v.photons
+        );
+        println!("  initial  {}", v.initial.evaluation);
+        println!("  final    {}", v.final_design.evaluation);
+    }
 }
 
 fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {

@@ -1,4 +1,5 @@
-//! Dot-density optimization: find the ink-dot density `d(x)` that makes the backlight
+//! Optimization. With `--vary`, any numbers of the scene file ([`layout`]); otherwise the
+//! dot density. Dot-density optimization: find the ink-dot density `d(x)` that makes the backlight
 //! uniform (the founding paper's section 4), by Nelder-Mead over the density polynomial's
 //! coefficients or by a faster feedback on a tabulated density.
 //!
@@ -49,6 +50,7 @@ mod charts;
 pub mod export;
 pub mod feedback;
 mod feedback_search;
+pub mod layout;
 pub mod nelder_mead;
 pub mod objective;
 mod options;
@@ -61,6 +63,7 @@ mod traced;
 mod verify;
 mod write;
 
+pub use layout::{LayoutResult, optimize_layout};
 pub use options::{Method, OptimizeOptions};
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};
@@ -82,6 +85,9 @@ pub fn optimize(
     progress: &mut dyn FnMut(&IterationReport),
 ) -> Result<OptimizeResult> {
     check_method_options(options)?;
+    if !options.vary.is_empty() {
+        bail!("--vary variables are optimized by optimize_layout");
+    }
     let mut search = Search::new(scene, options)?;
     let tag = scene.tags[search.tag_id].clone();
     let dots_placement = export_placement(search.pattern.placement, &tag, options)?;
@@ -89,6 +95,7 @@ pub fn optimize(
     let termination = match options.method {
         Method::NelderMead => run_nelder_mead(&mut search, progress)?,
         Method::Feedback => run_feedback(&mut search, progress)?,
+        Method::Grid => bail!("--method grid needs --vary"),
     };
     let seconds = search.start.elapsed().as_secs_f64();
     let (Some((first_run, first_ev)), Some((best_run, best_ev, final_density))) =

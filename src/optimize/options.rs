@@ -1,5 +1,6 @@
 //! How to optimize: the method and the options of `blutrace optimize`, checked.
 
+use super::layout::{ObjectiveSpec, VarySpec};
 use crate::accel::BackendChoice;
 use crate::optics::dots::Placement;
 use crate::optics::surface::Estimator;
@@ -16,6 +17,8 @@ pub enum Method {
     NelderMead,
     /// Damped per-strip ratio updates of a tabulated density.
     Feedback,
+    /// With `--vary`: a scan of one or two variables on a grid of `--grid-points` each.
+    Grid,
 }
 
 impl std::fmt::Display for Method {
@@ -23,6 +26,7 @@ impl std::fmt::Display for Method {
         f.write_str(match self {
             Method::NelderMead => "nelder-mead",
             Method::Feedback => "feedback",
+            Method::Grid => "grid",
         })
     }
 }
@@ -31,9 +35,21 @@ impl std::fmt::Display for Method {
 /// defaults, also behind [`Default`]).
 #[derive(Clone, Debug, Serialize, clap::Args)]
 pub struct OptimizeOptions {
-    /// Nelder-Mead over the density polynomial (the paper's), or per-strip feedback.
+    /// Nelder-Mead over the density polynomial (the paper's), or per-strip feedback; with
+    /// --vary: Nelder-Mead over the variables, or a grid scan of one or two.
     #[arg(long, value_enum, default_value = "nelder-mead")]
     pub method: Method,
+    /// A number of the scene file to optimize, KEY=MIN..MAX (repeatable): KEY a dotted path
+    /// such as sources.0.center.2, `*` for every element of an array (set together).
+    #[arg(long, value_name = "KEY=MIN..MAX")]
+    pub vary: Vec<VarySpec>,
+    /// With --vary: cv (debiased area cv), thirteen-point (1 - 13-point min/max),
+    /// efficiency (1 - extraction efficiency), or a weighted mix NAME=W,NAME=W.
+    #[arg(long, default_value = "cv")]
+    pub objective: ObjectiveSpec,
+    /// With --method grid: points per variable, ends included.
+    #[arg(long, default_value_t = 7)]
+    pub grid_points: usize,
     /// Photons per evaluated design.
     #[arg(long, default_value_t = 1_000_000)]
     pub photons: u64,
@@ -64,10 +80,12 @@ pub struct OptimizeOptions {
     /// The dots surface to optimize (default: the scene's only one).
     #[arg(long)]
     pub tag: Option<String>,
-    /// Nelder-Mead: initial simplex step (density units at the far end).
+    /// Nelder-Mead: initial simplex step (density units at the far end; with --vary, a
+    /// fraction of each variable's range).
     #[arg(long, default_value_t = 0.2)]
     pub initial_step: f64,
-    /// Nelder-Mead: stop once the simplex is smaller than this (density units).
+    /// Nelder-Mead: stop once the simplex is smaller than this (density units; with --vary,
+    /// a fraction of each variable's range).
     #[arg(long, default_value_t = 2e-3)]
     pub simplex_tol: f64,
     /// Feedback: damping exponent of d <- d (target / measured)^alpha.
@@ -184,6 +202,9 @@ fn parse_cells(s: &str) -> Result<(usize, usize), String> {
 
 /// Options that only one method takes must not be given to the other.
 pub(super) fn check_method_options(options: &OptimizeOptions) -> Result<()> {
+    if options.vary.is_empty() && options.method == Method::Grid {
+        bail!("--method grid scans --vary variables: give at least one --vary KEY=MIN..MAX");
+    }
     if !(1..=2).contains(&options.dims) {
         bail!("--dims must be 1 or 2, got {}", options.dims);
     }
@@ -230,6 +251,8 @@ mod tests {
         assert!(d.target_cv.is_none() && d.degree.is_none() && d.max_density.is_none());
         assert!(d.tag.is_none() && d.cells.is_none() && d.strips.is_none());
         assert!(d.verify_seed.is_none() && d.threads.is_none());
+        assert!(d.vary.is_empty() && d.grid_points == 7);
+        assert_eq!(d.objective, ObjectiveSpec::default());
     }
 
     #[test]

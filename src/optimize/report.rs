@@ -56,7 +56,7 @@ impl std::fmt::Display for IterationReport {
                 let c: Vec<String> = self.params.iter().map(|c| format!("{c:.4}")).collect();
                 write!(f, "  c = [{}]", c.join(", "))
             }
-            Method::Feedback => {
+            Method::Feedback | Method::Grid => {
                 let (lo, hi) = self
                     .params
                     .iter()

@@ -56,13 +56,13 @@ impl OptimizeResult {
 
 /// `file` as TOML. Through a `toml::Value`, whose tables sort their keys: the sections
 /// and keys come out in alphabetical order, not in the structs' field order.
-fn to_toml(file: &SceneFile) -> Result<String> {
+pub(super) fn to_toml(file: &SceneFile) -> Result<String> {
     let value = toml::Value::try_from(file).context("cannot write the optimized scene")?;
     toml::to_string(&value).context("cannot write the optimized scene as TOML")
 }
 
 /// The scene file at `path`, parsed.
-fn read_scene_file(path: &Path) -> Result<SceneFile> {
+pub(super) fn read_scene_file(path: &Path) -> Result<SceneFile> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read scene file", path.display()))?;
     toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
@@ -70,7 +70,7 @@ fn read_scene_file(path: &Path) -> Result<SceneFile> {
 
 /// Make the geometry files and the sources' intensity files absolute (they are relative
 /// to `base`, the folder of the scene file `path`).
-fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result<()> {
+pub(super) fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result<()> {
     let absolute = |p: &mut PathBuf| -> Result<()> {
         let joined = base.join(&*p);
         let found = joined

@@ -31,17 +31,29 @@ impl TracedRun {
         margin: f64,
         tag_id: usize,
     ) -> Result<(TracedRun, Evaluation)> {
+        let (run, evaluation) = Self::trace_judged(scene, options, |r| -> Result<Evaluation> {
+            let pattern = dots_pattern(r.scene, tag_id)?;
+            Ok(Evaluation::of(
+                r.scene,
+                pattern,
+                r.flux_map(),
+                strips,
+                margin,
+                r.tally.ledger.photons,
+                r.runtime_s,
+            ))
+        })?;
+        Ok((run, evaluation?))
+    }
+
+    /// Trace `scene` and judge the finished run with `judge`.
+    pub(super) fn trace_judged<T>(
+        scene: Scene,
+        options: &RunOptions,
+        judge: impl FnOnce(&RunResult) -> T,
+    ) -> Result<(TracedRun, T)> {
         let r = run::trace(&scene, options, &|_| {})?;
-        let pattern = dots_pattern(&scene, tag_id)?;
-        let evaluation = Evaluation::of(
-            &scene,
-            pattern,
-            r.flux_map(),
-            strips,
-            margin,
-            r.tally.ledger.photons,
-            r.runtime_s,
-        );
+        let judged = judge(&r);
         let RunResult {
             scene: _,
             backend,
@@ -64,7 +76,7 @@ impl TracedRun {
             stopped_by,
             history,
         };
-        Ok((traced, evaluation))
+        Ok((traced, judged))
     }
 
     /// The run as a [`RunResult`] (for its summary and output files).

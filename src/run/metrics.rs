@@ -340,27 +340,35 @@ pub fn median(mut values: Vec<f64>) -> f64 {
 /// Jackknife standard errors of every metric from the per-group tallies.
 /// Returns NaN errors when fewer than two groups hold photons.
 pub fn jackknife(scene: &Scene, groups: &[Tally]) -> MetricValues {
+    let leave_out = leave_one_out(scene, groups);
+    MetricValues::from_fn(|m| jackknife_stderr(&leave_out.iter().map(|v| v[m]).collect::<Vec<_>>()))
+}
+
+/// Every metric of the run with each group left out in turn (the groups holding photons).
+pub fn leave_one_out(scene: &Scene, groups: &[Tally]) -> Vec<MetricValues> {
     let used: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
-    let k = used.len();
-    if k < 2 {
-        return MetricValues::splat(f64::NAN);
-    }
     let mut total = Tally::new(scene);
     used.iter().for_each(|g| total.merge(g));
     // Leaving a group out = taking it out of the total: exact, as the sums are integers.
-    let leave_out: Vec<MetricValues> = used
-        .iter()
+    used.iter()
         .map(|g| {
             let mut t = total.clone();
             t.merge_signed(g, Sign::Remove);
             Metrics::of(scene, &t).values()
         })
-        .collect();
-    MetricValues::from_fn(|m| {
-        let mean = leave_out.iter().map(|v| v[m]).sum::<f64>() / k as f64;
-        let ss: f64 = leave_out.iter().map(|v| (v[m] - mean).powi(2)).sum();
-        ((k - 1) as f64 / k as f64 * ss).sqrt()
-    })
+        .collect()
+}
+
+/// The jackknife standard error `sqrt((k - 1) / k sum (x_i - mean)^2)` of a statistic
+/// from its `k` leave-one-out values (NaN for fewer than two).
+pub fn jackknife_stderr(leave_out: &[f64]) -> f64 {
+    let k = leave_out.len();
+    if k < 2 {
+        return f64::NAN;
+    }
+    let mean = leave_out.iter().sum::<f64>() / k as f64;
+    let ss: f64 = leave_out.iter().map(|v| (v - mean).powi(2)).sum();
+    ((k - 1) as f64 / k as f64 * ss).sqrt()
 }
 
 /// Every metric of the tally `total` and its standard error (jackknife over `groups`,

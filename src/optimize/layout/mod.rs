@@ -1,0 +1,290 @@
+//! Layout and shape optimization: any numbers of the scene file (lamp height and pitch, a
+//! source row's lamp count, a procedural reflector's ridge height, even the dot density's
+//! coefficients) as the variables of a search.
+//!
+//! ```text
+//! blutrace optimize scenes/direct-lit --vary 'sources.*.center.2=4..20' \
+//!     --vary procedural.0.ridge_height_mm=0..15 [--objective cv] [--method nelder-mead|grid]
+//! ```
+//!
+//! - [`vary`]: `--vary KEY=MIN..MAX`, the dotted paths into the scene file.
+//! - [`objective`]: debiased area cv, 13-point ratio, efficiency or a weighted mix, with
+//!   jackknife errors.
+//! - The search: integer variables (a row's `count`) are enumerated, and for each of their
+//!   combinations the continuous ones are searched by Nelder-Mead (the dots optimizer's,
+//!   in coordinates scaled to each variable's range, `--initial-step` and `--simplex-tol`
+//!   being fractions of the range; a point outside the bounds is not traced and gets the
+//!   penalty `1000 + distance`) or scanned on a grid of `--grid-points` per variable (one
+//!   or two variables). Every design is traced with the same seed and photons (common
+//!   random numbers); a design whose scene does not load (a lamp row wider than its box)
+//!   gets the penalty, and its reason is reported.
+//! - After the search the scene's own design and the best one are re-traced with a fresh
+//!   seed and `--verify-photons`.
+
+pub mod objective;
+mod result;
+mod search;
+pub mod vary;
+mod write;
+
+pub use objective::{LayoutEvaluation, ObjectiveSpec};
+pub use result::{IntegerCase, LayoutResult, LayoutVerification, VariableResult, VerifiedLayout};
+pub use search::EvaluationRecord;
+pub use vary::{Variable, VarySpec};
+
+use super::nelder_mead::{self, Settings};
+use super::{Method, OptimizeOptions};
+use crate::run::RunOptions;
+use crate::scene::Scene;
+use anyhow::{Context, Result, bail};
+use search::{LayoutSearch, PENALTY};
+use std::time::Instant;
+use toml::Value;
+
+/// Most combinations of integer values a search enumerates.
+const MAX_CASES: usize = 1000;
+
+/// Optimize the `--vary` variables of `scene`; `progress` sees every evaluated design with
+/// the variables' names.
+pub fn optimize_layout(
+    scene: &Scene,
+    options: &OptimizeOptions,
+    progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
+) -> Result<LayoutResult> {
+    let text = std::fs::read_to_string(&scene.path)
+        .with_context(|| format!("{}: cannot read scene file", scene.path.display()))?;
+    let doc: Value =
+        toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", scene.path.display()))?;
+    let vars = resolve_variables(&doc, options)?;
+    check_method(options, &vars)?;
+    if options.photons == 0 {
+        bail!("--photons must be at least 1");
+    }
+    let mut search = LayoutSearch {
+        scene,
+        doc,
+        vars,
+        objective: options.objective.clone(),
+        options,
+        run_options: RunOptions {
+            photons: options.photons,
+            seed: options.seed,
+            threads: options.threads,
+            backend: options.backend,
+            estimator: options.estimator,
+            ..RunOptions::default()
+        },
+        start: Instant::now(),
+        photons: 0,
+        history: Vec::new(),
+        best: None,
+        seen: Default::default(),
+    };
+    let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
+    search.evaluate(&initial_x, progress)?;
+    let Some((_, initial, _)) = search.best.clone() else {
+        bail!("the scene's own design was not traced");
+    };
+    if search.vars.iter().any(|v| !v.contains(v.initial)) {
+        // The scene's count lies outside the enumerated range: not a candidate.
+        search.best = None;
+    }
+    let mut cases = Vec::new();
+    for ints in integer_cases(&search.vars)? {
+        cases.push(search_case(&mut search, &ints, progress)?);
+    }
+    let Some((_, best, best_x)) = search.best.clone() else {
+        bail!("the search traced no design");
+    };
+    result::finish(search, initial, best, best_x, cases)
+}
+
+/// The variables of `--vary`, resolved; continuous ones must start inside their range.
+fn resolve_variables(doc: &Value, options: &OptimizeOptions) -> Result<Vec<Variable>> {
+    let vars: Vec<Variable> = options
+        .vary
+        .iter()
+        .map(|s| Variable::resolve(doc, s))
+        .collect::<Result<_>>()?;
+    for (i, v) in vars.iter().enumerate() {
+        if let Some(w) = vars[..i].iter().find(|w| w.overlaps(v)) {
+            bail!(
+                "--vary {} and --vary {} set the same number",
+                w.name,
+                v.name
+            );
+        }
+        if !v.integer && !(v.min..=v.max).contains(&v.initial) {
+            bail!(
+                "--vary {}: the scene's value {} is outside {}..{} (the search starts from the scene's design)",
+                v.name,
+                v.initial,
+                v.min,
+                v.max
+            );
+        }
+    }
+    Ok(vars)
+}
+
+/// The method must suit the variables, and options of the dots objective are not given.
+fn check_method(options: &OptimizeOptions, vars: &[Variable]) -> Result<()> {
+    let o = options;
+    for (given, flag) in [
+        (o.tag.is_some(), "--tag"),
+        (o.degree.is_some(), "--degree"),
+        (o.strips.is_some(), "--strips"),
+        (o.cells.is_some(), "--cells"),
+        (o.max_density.is_some(), "--max-density"),
+        (o.target_cv.is_some(), "--target-cv"),
+        (o.dims != 1, "--dims"),
+    ] {
+        if given {
+            bail!(
+                "{flag} is an option of the dot-density search, not of --vary (vary the density's keys instead)"
+            );
+        }
+    }
+    let continuous = vars.iter().filter(|v| !v.integer).count();
+    match options.method {
+        Method::Feedback => {
+            bail!("--method feedback tunes dot densities; with --vary use nelder-mead or grid")
+        }
+        Method::Grid if !(1..=2).contains(&continuous) => {
+            bail!("--method grid scans one or two continuous variables, got {continuous}")
+        }
+        Method::Grid if options.grid_points < 2 => {
+            bail!(
+                "--grid-points must be at least 2, got {}",
+                options.grid_points
+            )
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Every combination of the integer variables' values (one empty case when there are
+/// none), at most [`MAX_CASES`].
+fn integer_cases(vars: &[Variable]) -> Result<Vec<Vec<Option<f64>>>> {
+    let mut cases: Vec<Vec<Option<f64>>> = vec![Vec::new()];
+    for v in vars {
+        let values: Vec<Option<f64>> = if v.integer {
+            v.integers().into_iter().map(Some).collect()
+        } else {
+            vec![None]
+        };
+        if cases.len() * values.len() > MAX_CASES {
+            bail!(
+                "the integer variables have more than {MAX_CASES} combinations: narrow their ranges"
+            );
+        }
+        cases = cases
+            .into_iter()
+            .flat_map(|c| {
+                values.iter().map(move |x| {
+                    let mut c = c.clone();
+                    c.push(*x);
+                    c
+                })
+            })
+            .collect();
+    }
+    Ok(cases)
+}
+
+/// Search the continuous variables with the integer ones fixed at `ints` (None for the
+/// continuous ones).
+fn search_case(
+    search: &mut LayoutSearch,
+    ints: &[Option<f64>],
+    progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
+) -> Result<IntegerCase> {
+    let free: Vec<usize> = (0..ints.len()).filter(|&i| ints[i].is_none()).collect();
+    let full = |search: &LayoutSearch, z: &[f64]| -> Vec<f64> {
+        let mut x: Vec<f64> = ints.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
+        for (&i, z) in free.iter().zip(z) {
+            let v = &search.vars[i];
+            x[i] = v.min + z * (v.max - v.min);
+        }
+        x
+    };
+    let scaled: Vec<f64> = free
+        .iter()
+        .map(|&i| {
+            let v = &search.vars[i];
+            (v.initial - v.min) / (v.max - v.min)
+        })
+        .collect();
+    let evaluations = search.history.len();
+    let mut case_best: Option<(f64, f64, Vec<f64>)> = None;
+    let mut eval = |search: &mut LayoutSearch, z: &[f64]| -> Result<f64> {
+        let x = full(search, z);
+        let outside = z.iter().map(|z| (-z).max(z - 1.0)).fold(0.0, f64::max);
+        if outside > 0.0 {
+            search.reject_out_of_bounds(&x, progress);
+            return Ok(PENALTY + outside);
+        }
+        let (value, noise) = search.evaluate(&x, progress)?;
+        if case_best.as_ref().is_none_or(|(b, _, _)| value < *b) {
+            case_best = Some((value, noise, x));
+        }
+        Ok(value)
+    };
+    let termination = match (free.is_empty(), search.options.method) {
+        (true, _) => {
+            eval(search, &[])?;
+            "no continuous variable: traced once".to_string()
+        }
+        (false, Method::Grid) => {
+            let k = search.options.grid_points;
+            let axis: Vec<f64> = (0..k).map(|j| j as f64 / (k - 1) as f64).collect();
+            let points: Vec<Vec<f64>> = match free.len() {
+                1 => axis.iter().map(|&a| vec![a]).collect(),
+                _ => axis
+                    .iter()
+                    .flat_map(|&b| axis.iter().map(move |&a| vec![a, b]))
+                    .collect(),
+            };
+            for z in &points {
+                eval(search, z)?;
+            }
+            format!("grid of {} designs scanned", points.len())
+        }
+        (false, _) => {
+            let o = search.options;
+            let steps: Vec<f64> = scaled
+                .iter()
+                .map(|z| {
+                    if z + o.initial_step <= 1.0 {
+                        o.initial_step
+                    } else {
+                        -o.initial_step
+                    }
+                })
+                .collect();
+            let settings = Settings {
+                max_iter: o.max_iter,
+                x_tol: o.simplex_tol,
+                ..Settings::default()
+            };
+            let out = nelder_mead::minimize(
+                &mut |z| eval(search, z),
+                &scaled,
+                &steps,
+                &settings,
+                &mut |_| {},
+            )?;
+            format!("{} after {} iterations", out.termination, out.iterations)
+        }
+    };
+    let (objective, noise, values) =
+        case_best.unwrap_or((f64::NAN, f64::NAN, full(search, &scaled)));
+    Ok(IntegerCase {
+        integers: ints.iter().flatten().copied().collect(),
+        values,
+        objective,
+        noise,
+        evaluations: search.history.len() - evaluations,
+        termination,
+    })
+}

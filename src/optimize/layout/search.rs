@@ -1,0 +1,162 @@
+//! The state of one layout search: the scene file as a value tree, the variables, the
+//! traces so far and the best design.
+
+use super::objective::{LayoutEvaluation, ObjectiveSpec};
+use super::vary::Variable;
+use crate::optimize::OptimizeOptions;
+use crate::optimize::traced::TracedRun;
+use crate::run::RunOptions;
+use crate::scene::Scene;
+use crate::scene::config::SceneFile;
+use anyhow::Result;
+use serde::Serialize;
+use std::collections::HashMap;
+use std::time::Instant;
+use toml::Value;
+
+/// Objective of a design the search does not trace (outside the bounds, or a scene that
+/// does not load): worse than any traced design, and growing with the distance outside
+/// the bounds so the simplex is pulled back in.
+pub(super) const PENALTY: f64 = 1000.0;
+
+/// One evaluated design: a row of `history.csv` and a progress line.
+#[derive(Clone, Debug, Serialize)]
+pub struct EvaluationRecord {
+    /// Designs evaluated so far, this one included.
+    pub evaluation: usize,
+    /// The variables' values, in the order given.
+    pub values: Vec<f64>,
+    /// The traced design's objective and metrics (None: not traced).
+    pub result: Option<LayoutEvaluation>,
+    /// Why the design was not traced.
+    pub rejected: Option<String>,
+    /// Photons traced so far.
+    pub photons: u64,
+    /// Wall time so far (s).
+    pub seconds: f64,
+}
+
+impl EvaluationRecord {
+    /// `name = value` of every variable.
+    pub fn assignment(&self, names: &[String]) -> String {
+        names
+            .iter()
+            .zip(&self.values)
+            .map(|(n, v)| format!("{n} = {v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// What the search needs while it runs.
+pub(super) struct LayoutSearch<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) doc: Value,
+    pub(super) vars: Vec<Variable>,
+    pub(super) objective: ObjectiveSpec,
+    pub(super) options: &'a OptimizeOptions,
+    pub(super) run_options: RunOptions,
+    pub(super) start: Instant,
+    pub(super) photons: u64,
+    pub(super) history: Vec<EvaluationRecord>,
+    /// The best traced design: its run, evaluation and variables.
+    pub(super) best: Option<(TracedRun, LayoutEvaluation, Vec<f64>)>,
+    /// Objective of every design evaluated, by the bits of its variables: a design met
+    /// again (the scene's own at the start of each case) is not traced twice.
+    pub(super) seen: HashMap<Vec<u64>, (f64, f64)>,
+}
+
+impl<'a> LayoutSearch<'a> {
+    /// The variables' names.
+    pub(super) fn names(&self) -> Vec<String> {
+        self.vars.iter().map(|v| v.name.clone()).collect()
+    }
+
+    /// The scene file with the variables set to `x`.
+    pub(super) fn document(&self, x: &[f64]) -> Value {
+        let mut doc = self.doc.clone();
+        for (v, &x) in self.vars.iter().zip(x) {
+            v.set(&mut doc, x);
+        }
+        doc
+    }
+
+    /// The design `x` as a loaded scene, or why it does not load.
+    pub(super) fn design(&self, x: &[f64]) -> Result<Scene> {
+        let file: SceneFile = self
+            .document(x)
+            .try_into()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", self.scene.path.display()))?;
+        Scene::from_file(&file, &self.scene.path)
+    }
+
+    /// Trace the design `x` with `run_options` and judge it.
+    pub(super) fn trace(
+        &self,
+        scene: Scene,
+        run_options: &RunOptions,
+    ) -> Result<(TracedRun, LayoutEvaluation)> {
+        TracedRun::trace_judged(scene, run_options, |r| self.objective.evaluate(r))
+    }
+
+    /// Evaluate the design `x` (inside the bounds): its objective and standard error, or
+    /// the penalty when the scene does not load. Keeps the best; `progress` sees the record.
+    pub(super) fn evaluate(
+        &mut self,
+        x: &[f64],
+        progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
+    ) -> Result<(f64, f64)> {
+        let key: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
+        if let Some(&seen) = self.seen.get(&key) {
+            return Ok(seen);
+        }
+        let (result, rejected, value) = match self.design(x) {
+            Ok(scene) => {
+                let (run, ev) = self.trace(scene, &self.run_options.clone())?;
+                self.photons += ev.photons;
+                let value = ev.objective;
+                if self
+                    .best
+                    .as_ref()
+                    .is_none_or(|(_, b, _)| value < b.objective)
+                {
+                    self.best = Some((run, ev.clone(), x.to_vec()));
+                }
+                (Some(ev), None, value)
+            }
+            Err(e) => (None, Some(format!("{e:#}")), PENALTY),
+        };
+        let noise = result.as_ref().map_or(f64::NAN, |r| r.noise);
+        self.seen.insert(key, (value, noise));
+        self.record(x, result, rejected, progress);
+        Ok((value, noise))
+    }
+
+    /// Record a design out of the bounds (not traced).
+    pub(super) fn reject_out_of_bounds(
+        &mut self,
+        x: &[f64],
+        progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
+    ) {
+        self.record(x, None, Some("outside the bounds".into()), progress);
+    }
+
+    fn record(
+        &mut self,
+        x: &[f64],
+        result: Option<LayoutEvaluation>,
+        rejected: Option<String>,
+        progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
+    ) {
+        let r = EvaluationRecord {
+            evaluation: self.history.len() + 1,
+            values: x.to_vec(),
+            result,
+            rejected,
+            photons: self.photons,
+            seconds: self.start.elapsed().as_secs_f64(),
+        };
+        progress(&r, &self.names());
+        self.history.push(r);
+    }
+}

@@ -23,9 +23,13 @@
 //! # intensity_file = "led.ies"  # instead of cos_exponent: a measured I(theta) table
 //! ```
 //!
+//! Any entry may stand for a row of identical sources (`array = { count, pitch_mm,
+//! direction }`, see [`array`]).
+//!
 //! An LED with `intensity_file` becomes an [`Emitter::MeasuredLed`]; see [`intensity`]
 //! for the CSV and IES LM-63 formats and how the table is sampled.
 
+pub mod array;
 pub mod body;
 pub mod body_shape;
 pub mod intensity;
@@ -70,6 +74,9 @@ pub enum SourceSpec {
         /// What light returning to the tube meets ([`body`]).
         #[serde(default)]
         body: BodySpec,
+        /// A row of copies of this source ([`array`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        array: Option<array::ArraySpec>,
     },
     /// Flat LED emitter.
     Led {
@@ -107,10 +114,20 @@ pub enum SourceSpec {
         /// is the rectangle itself.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         package_depth_mm: Option<f64>,
+        /// A row of copies of this source ([`array`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        array: Option<array::ArraySpec>,
     },
 }
 
 impl SourceSpec {
+    /// The entry's row, if it has one.
+    pub fn array(&self) -> Option<&array::ArraySpec> {
+        match self {
+            SourceSpec::Ccfl { array, .. } | SourceSpec::Led { array, .. } => array.as_ref(),
+        }
+    }
+
     /// Check entry `i` of `[[sources]]` and build the source (a measured LED's
     /// `intensity_file` is relative to the scene file).
     pub fn build(&self, ctx: &Ctx, i: usize, media: &[Medium]) -> Result<Source> {
@@ -311,6 +328,18 @@ impl Source {
         }
     }
 
+    /// Move the source (and its body) by `d`.
+    pub fn translate(&mut self, d: DVec3) {
+        match &mut self.emitter {
+            Emitter::Ccfl { center, .. }
+            | Emitter::Led { center, .. }
+            | Emitter::MeasuredLed { center, .. } => *center += d,
+        }
+        if let Some(b) = &mut self.body {
+            b.shape.translate(d);
+        }
+    }
+
     /// A photon leaving this source: its ray and the emitting surface's normal.
     pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3) {
         match &self.emitter {
@@ -493,16 +522,18 @@ impl Sources {
         if specs.is_empty() {
             return Err(ctx.err("sources", "the scene needs at least one [[sources]] entry"));
         }
-        let list = specs
-            .iter()
-            .enumerate()
-            .map(|(i, s)| s.build(ctx, i, media))
-            .collect::<Result<Vec<_>>>()?;
-        for (i, s) in list.iter().enumerate() {
-            if let Some(j) = list[..i].iter().position(|o| o.name == s.name) {
+        let (mut list, mut entry) = (Vec::with_capacity(specs.len()), Vec::new());
+        for (i, s) in specs.iter().enumerate() {
+            let row = array::replicate(ctx, i, s.build(ctx, i, media)?, s.array())?;
+            entry.extend(std::iter::repeat_n(i, row.len()));
+            list.extend(row);
+        }
+        for (k, s) in list.iter().enumerate() {
+            if let Some(j) = list[..k].iter().position(|o| o.name == s.name) {
+                let (i, j) = (entry[k], entry[j]);
                 return Err(ctx.err(
                     &format!("sources[{i}].name"),
-                    format!("'{}' is already the name of sources[{j}]; names must be unique (the ledger books each lamp body's absorption by name)", s.name),
+                    format!("'{}' is already the name of sources[{j}] (or one of its row); names must be unique (the ledger books each lamp body's absorption by name)", s.name),
                 ));
             }
         }
@@ -518,16 +549,7 @@ impl Sources {
 
     /// Move every source (and its body) by `d`.
     pub fn translate(&mut self, d: DVec3) {
-        for s in &mut self.list {
-            match &mut s.emitter {
-                Emitter::Ccfl { center, .. }
-                | Emitter::Led { center, .. }
-                | Emitter::MeasuredLed { center, .. } => *center += d,
-            }
-            if let Some(b) = &mut s.body {
-                b.shape.translate(d);
-            }
-        }
+        self.list.iter_mut().for_each(|s| s.translate(d));
     }
 
     /// Luminous efficacy of the radiation (lm/W) when every source gives its lumens.

@@ -8,6 +8,13 @@
 //! file = "notebook14.obj"    # OBJ (usemtl names, else group/object names, are tags)
 //! translate = [0.0, 0.0, 0.0]
 //!
+//! [[procedural]]              # parametric reflectors generated at load: see `procedural`
+//! type = "direct_lit_box"
+//! tag = "box_reflector"
+//! origin = [0.0, 0.0, 0.0]
+//! size_mm = [400.0, 250.0, 25.0]
+//! ridge_height_mm = 6.0
+//!
 //! [media.pmma]
 //! n = 1.49
 //! absorption_per_mm = 0.0
@@ -35,6 +42,7 @@
 //! the modules that implement them.
 
 pub use super::geometry_file::GeometrySpec;
+pub use super::procedural::ProceduralSpec;
 use crate::optics::absorber::AbsorberSpec;
 pub use crate::optics::density::DensityGridSpec;
 use crate::optics::dielectric::DielectricSpec;
@@ -63,7 +71,11 @@ pub struct SceneFile {
     /// Free text.
     pub description: Option<String>,
     /// Geometry files, relative to the scene file.
+    #[serde(default)]
     pub geometry: Vec<GeometrySpec>,
+    /// Parts generated at load ([`super::procedural`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub procedural: Vec<ProceduralSpec>,
     /// Named media (`air` exists unless redefined).
     #[serde(default)]
     pub media: BTreeMap<String, MediumSpec>,

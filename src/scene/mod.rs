@@ -14,6 +14,7 @@ pub mod geometry_report;
 mod hash;
 mod lamp_placement;
 pub mod meshio;
+pub mod procedural;
 mod solids;
 
 use crate::accel::convex::ConvexSolid;
@@ -96,7 +97,10 @@ impl Scene {
         }
         let mut warnings = Vec::new();
         let media = medium::build_media(&ctx, &file.media)?;
-        let (mut mesh, tags, geometry) = load_geometry(&ctx, file, path, &mut warnings)?;
+        // Sources first: procedural reflectors follow the lamps.
+        let sources = Sources::build(&ctx, &file.sources, &media)?;
+        let (mut mesh, tags, geometry) =
+            load_geometry(&ctx, file, path, &sources.list, &mut warnings)?;
         let mut surfaces = Vec::with_capacity(tags.len());
         for tag in &tags {
             let spec = file
@@ -117,7 +121,6 @@ impl Scene {
             &media,
         ));
         fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
-        let sources = Sources::build(&ctx, &file.sources, &media)?;
         lamp_placement::check_source_media(
             &ctx,
             &mesh,
@@ -316,6 +319,7 @@ fn load_geometry(
     ctx: &Ctx,
     file: &SceneFile,
     path: &Path,
+    lamps: &[crate::sources::Source],
     warnings: &mut Vec<String>,
 ) -> Result<(Mesh, Vec<String>, Vec<GeometryReport>)> {
     let dir = path.parent().unwrap_or(Path::new("."));
@@ -351,50 +355,87 @@ fn load_geometry(
                 ),
             ));
         }
-        let base = mesh.positions.len() as u32;
-        let first = mesh.triangles.len();
-        mesh.positions.extend(&tris.positions);
-        let mut dropped = 0;
-        for (t, tag) in tris.triangles.iter().zip(&tris.tags) {
-            if !file.surfaces.contains_key(tag) {
-                return Err(ctx.err(
-                    "surfaces",
-                    format!(
-                        "{} uses tag '{tag}', but the scene has no [surfaces.{tag}]",
-                        gpath.display()
-                    ),
-                ));
-            }
-            let tri = t.map(|v| v + base);
-            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-            if (b - a).cross(c - a).length_squared() == 0.0 {
-                dropped += 1;
-                continue;
-            }
-            let id = match tags.iter().position(|x| x == tag) {
-                Some(p) => p,
-                None => {
-                    tags.push(tag.clone());
-                    tags.len() - 1
-                }
-            };
-            mesh.triangles.push(tri);
-            mesh.tri_tag.push(id as u32);
-        }
-        if dropped > 0 {
-            warnings.push(format!(
-                "{}: dropped {dropped} zero-area triangle(s)",
-                gpath.display()
-            ));
-        }
-        let kept: Vec<([u32; 3], &str)> = (first..mesh.triangles.len())
-            .map(|k| (mesh.triangles[k], tags[mesh.tri_tag[k] as usize].as_str()))
-            .collect();
-        let report = GeometryReport::new(g.file.display().to_string(), &mesh, &kept);
-        warnings.extend(report.extent_warning());
-        reports.push(report);
+        let part = Part {
+            label: gpath.display().to_string(),
+            name: g.file.display().to_string(),
+        };
+        reports.push(add_part(
+            ctx, file, &mut mesh, &mut tags, &part, &tris, warnings,
+        )?);
+    }
+    for (i, p) in file.procedural.iter().enumerate() {
+        let tris = p.build(ctx, i, lamps)?;
+        let name = format!("procedural[{i}]");
+        let part = Part {
+            label: format!("{}: {name}", ctx.0.display()),
+            name,
+        };
+        reports.push(add_part(
+            ctx, file, &mut mesh, &mut tags, &part, &tris, warnings,
+        )?);
     }
     Ok((mesh, tags, reports))
+}
+
+/// A part's names: in messages (`label`) and in its report (`name`).
+struct Part {
+    label: String,
+    name: String,
+}
+
+/// Add a part's triangles to `mesh` (their tags to `tags`), dropping zero-area ones with
+/// a warning; returns the part's report.
+fn add_part(
+    ctx: &Ctx,
+    file: &SceneFile,
+    mesh: &mut Mesh,
+    tags: &mut Vec<String>,
+    part: &Part,
+    tris: &meshio::TaggedTriangles,
+    warnings: &mut Vec<String>,
+) -> Result<GeometryReport> {
+    let base = mesh.positions.len() as u32;
+    let first = mesh.triangles.len();
+    mesh.positions.extend(&tris.positions);
+    let mut dropped = 0;
+    for (t, tag) in tris.triangles.iter().zip(&tris.tags) {
+        if !file.surfaces.contains_key(tag) {
+            return Err(ctx.err(
+                "surfaces",
+                format!(
+                    "{} uses tag '{tag}', but the scene has no [surfaces.{tag}]",
+                    part.label
+                ),
+            ));
+        }
+        let tri = t.map(|v| v + base);
+        let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+        if (b - a).cross(c - a).length_squared() == 0.0 {
+            dropped += 1;
+            continue;
+        }
+        let id = match tags.iter().position(|x| x == tag) {
+            Some(p) => p,
+            None => {
+                tags.push(tag.clone());
+                tags.len() - 1
+            }
+        };
+        mesh.triangles.push(tri);
+        mesh.tri_tag.push(id as u32);
+    }
+    if dropped > 0 {
+        warnings.push(format!(
+            "{}: dropped {dropped} zero-area triangle(s)",
+            part.label
+        ));
+    }
+    let kept: Vec<([u32; 3], &str)> = (first..mesh.triangles.len())
+        .map(|k| (mesh.triangles[k], tags[mesh.tri_tag[k] as usize].as_str()))
+        .collect();
+    let report = GeometryReport::new(part.name.clone(), mesh, &kept);
+    warnings.extend(report.extent_warning());
+    Ok(report)
 }
 
 /// Check a surface entry and build its model (each model checks its own fields).

@@ -31,12 +31,13 @@
 //! box, ridges of `ridge_height_mm` midway between neighbouring lamps and at the x walls
 //! (the shape `tools/scenegen` meshes for `direct-lit`), straight slopes (`triangle`) or
 //! parabolas with their vertex under the lamp (`parabola`); its side and end walls rise to
-//! the open top. It is open only along that top rim. The lamp holder is a sheet extruded
+//! the open top. It is open only along that top rim. A CCFL over the box that comes
+//! closer to its back, walls or top than its radius is an error. The lamp holder is a sheet extruded
 //! along the lamp, open only at its aperture. Faces are wound towards the lamps (into the
 //! box, towards the holder's axis).
 
 use super::meshio::TaggedTriangles;
-use crate::sources::Source;
+use crate::sources::{Emitter, Source};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -166,6 +167,14 @@ impl ProceduralSpec {
                 let segments = check_segments(ctx, &f("segments"), *segments)?;
                 let xs = valleys(origin, [size[0], size[1], size[2]], lamps);
                 let prof = back_profile(&xs, size[0], height, *profile, segments);
+                check_clearance(
+                    ctx,
+                    &f("ridge_height_mm"),
+                    origin,
+                    [size[0], size[1], size[2]],
+                    &prof,
+                    lamps,
+                )?;
                 Ok(direct_lit_box(
                     tag,
                     origin,
@@ -225,6 +234,54 @@ fn valleys(origin: DVec3, size: [f64; 3], lamps: &[Source]) -> Vec<f64> {
     xs.sort_by(f64::total_cmp);
     xs.dedup();
     xs
+}
+
+/// Every CCFL over the box must lie inside it, clear of the back and the x walls and
+/// below the top (light emitted inside a part would be wrong).
+fn check_clearance(
+    ctx: &Ctx,
+    field: &str,
+    origin: DVec3,
+    size: [f64; 3],
+    prof: &[[f64; 2]],
+    lamps: &[Source],
+) -> Result<()> {
+    for s in lamps {
+        let Emitter::Ccfl { center, radius, .. } = &s.emitter else {
+            continue;
+        };
+        let p = *center - origin;
+        if !(p.y >= 0.0 && p.y <= size[1] && p.x > -radius && p.x < size[0] + radius) {
+            continue;
+        }
+        let clear = prof
+            .windows(2)
+            .map(|w| point_segment([p.x, p.z], w[0], w[1]))
+            .chain([p.x, size[0] - p.x, size[2] - p.z])
+            .fold(f64::INFINITY, f64::min);
+        if clear < *radius {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "source '{}' has its axis {clear:.3} mm from the box's back, walls or top, less than its radius {radius} mm: the tube would cut the box",
+                    s.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Distance from `p` to the segment `a b` (x, z).
+fn point_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dz) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dz * dz;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dz) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dz)
 }
 
 /// The back's profile (x, z) from x = 0 to `width`: valleys at `xs`, ridges of `height`
@@ -706,6 +763,16 @@ mod tests {
         assert!(
             e(holder(Section::Parabola { focal_mm: 0.0 }, true))
                 .contains("procedural[0].section.focal_mm: must be > 0")
+        );
+        // Lamps 1 mm above the valleys: the tubes (radius 1.5) would cut the back.
+        let (_, mut lamps) = direct_lit();
+        lamps
+            .iter_mut()
+            .for_each(|l| l.translate(DVec3::new(0.0, 0.0, -7.0)));
+        let m = e(dl_box(6.0, Profile::Triangle, &lamps));
+        assert!(
+            m.contains("procedural[0].ridge_height_mm: source 'lamp1' has its axis 0.984 mm from"),
+            "{m}"
         );
     }
 }

@@ -96,3 +96,27 @@ fn the_ridge_height_is_a_variable() {
         "{objectives:?}"
     );
 }
+
+/// The bundled `direct-lit-rows` (a lamp row and a generated box) is `direct-lit` (six lamp
+/// entries and a meshed box): the same metrics within 3 combined standard errors.
+#[test]
+fn direct_lit_rows_is_direct_lit() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let meshed = load(&root.join("direct-lit/scene.toml"));
+    let rows = load(&root.join("direct-lit-rows/scene.toml"));
+    assert_eq!(rows.sources.list.len(), 6);
+    let a = support::trace(&meshed, 100_000, 9, 2);
+    let b = support::trace(&rows, 100_000, 9, 2);
+    let (va, ea) = with_errors(&meshed, &a.tally, &a.groups);
+    let (vb, eb) = with_errors(&rows, &b.tally, &b.groups);
+    for m in [Metric::Efficiency, Metric::Cv, Metric::ThirteenPoint] {
+        let s = ea[m].hypot(eb[m]);
+        assert!(
+            (va[m] - vb[m]).abs() < 3.0 * s,
+            "{}: {} vs {} ± {s}",
+            m.name(),
+            va[m],
+            vb[m]
+        );
+    }
+}

@@ -48,6 +48,7 @@ pub fn all_files() -> Vec<GenFile> {
     files.extend(scenes::test_two_tags::files());
     files.extend(scenes::phone_led::files());
     files.extend(scenes::direct_lit::files());
+    files.extend(scenes::direct_lit_rows::files());
     files.extend(scenes::cad_reflector::files());
     files.extend(scenes::prism_plate::files());
     files.extend(scenes::prism_plate::files_meshed());

@@ -5,6 +5,7 @@ pub mod bef_stack;
 pub mod cad_reflector;
 pub mod diffusion_lgp;
 pub mod direct_lit;
+pub mod direct_lit_rows;
 pub mod notebook14;
 pub mod phone_led;
 pub mod prism_plate;

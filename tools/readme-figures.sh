@@ -3,7 +3,7 @@
 # and the bench table. Results are deterministic (fixed seeds); only the timings depend on
 # the machine and its load, so run it on a quiet machine.
 #
-#   bash tools/readme-figures.sh [gallery|optimize|volume|bench|bodies|placement|all]   (default: all)
+#   bash tools/readme-figures.sh [gallery|optimize|layout|volume|bench|bodies|placement|all]   (default: all)
 #
 # Logs go to out/figures/*.log; the README tables are filled in from them by hand.
 set -euo pipefail
@@ -84,6 +84,17 @@ volume() {
     --nocapture >"$out/diffusion-lgp-profile.log" 2>&1
 }
 
+# README "Optimizing the layout and the reflectors": direct-lit-rows (6 lamps) over lamp
+# height, pitch and ridge height; then the lamp count 4..8 with the pitch searched for each.
+layout() {
+  timed "$out/layout-dl6.log" "$bin" optimize scenes/direct-lit-rows \
+    --vary 'sources.0.center.2=4..20' --vary sources.0.array.pitch_mm=50..75 \
+    --vary procedural.0.ridge_height_mm=0..15 --out "$out/layout-dl6"
+  timed "$out/layout-count.log" "$bin" optimize scenes/direct-lit-rows \
+    --vary sources.0.array.count=4..8 --vary sources.0.array.pitch_mm=40..110 \
+    --out "$out/layout-count"
+}
+
 bench() {
   "$bin" bench --photons 200000 >"$out/bench.log" 2>&1
 }
@@ -91,10 +102,11 @@ bench() {
 case "$what" in
   gallery) gallery ;;
   optimize) optimize ;;
+  layout) layout ;;
   volume) volume ;;
   bench) bench ;;
   bodies) bodies ;;
   placement) placement ;;
-  all) gallery; bodies; optimize; placement; volume; bench ;;
-  *) echo "usage: $0 [gallery|optimize|volume|bench|bodies|placement|all]" >&2; exit 2 ;;
+  all) gallery; bodies; optimize; layout; placement; volume; bench ;;
+  *) echo "usage: $0 [gallery|optimize|layout|volume|bench|bodies|placement|all]" >&2; exit 2 ;;
 esac

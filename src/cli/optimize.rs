@@ -170,7 +170,7 @@ pub fn print_layout_report(r: &LayoutResult) {
     );
     for v in &r.variables {
         println!(
-            "variable   {} = {} -> {} (range {}..{})",
+            "variable   {} = {} -> {:.4} (range {}..{})",
             v.name, v.initial, v.final_value, v.min, v.max
         );
     }

@@ -168,6 +168,12 @@ pub fn print_layout_report(r: &LayoutResult) {
         r.options.photons,
         r.best.noise_floor
     );
+    if r.best.below_noise_floor() || r.initial.below_noise_floor() {
+        println!(
+            "warning    a design's cv is below its noise floor at {} photons: the cv term compares noise, not designs; use more --photons",
+            r.options.photons
+        );
+    }
     for v in &r.variables {
         println!(
             "variable   {} = {} -> {:.4} (range {}..{})",

@@ -189,7 +189,19 @@ impl std::fmt::Display for LayoutEvaluation {
             self.thirteen_point_stderr,
             self.efficiency,
             self.efficiency_stderr
-        )
+        )?;
+        if self.below_noise_floor() {
+            f.write_str("  [cv below its noise floor: use more --photons]")?;
+        }
+        Ok(())
+    }
+}
+
+impl LayoutEvaluation {
+    /// True when the map's noise alone accounts for all of its cv: the debiased cv is
+    /// clamped at 0 and says nothing about the design.
+    pub fn below_noise_floor(&self) -> bool {
+        self.cv_debiased == 0.0
     }
 }
 

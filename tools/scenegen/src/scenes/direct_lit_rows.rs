@@ -10,7 +10,9 @@ use super::direct_lit::{
     Reflector, WALL_ALBEDO,
 };
 use super::{GENERATED, trace_table};
-use crate::{GenFile, ObjTags, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of};
+use crate::{
+    CCFL_BODY, GenFile, ObjTags, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
+};
 use crate::{write_mtl, write_obj};
 
 /// The plate's geometry file.
@@ -99,7 +101,7 @@ radius_mm = {r}
 length_mm = {len}
 power_w = {p}
 array = {{ count = {n}, pitch_mm = {pitch_num}, direction = [1.0, 0.0, 0.0] }}
-
+{CCFL_BODY}
 [detector]
 origin = {origin}
 u = [1.0, 0.0, 0.0]

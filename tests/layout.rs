@@ -410,3 +410,34 @@ fn row_pitch_over_seeds() {
         assert!((mean - want).abs() < 3.0 * sd / n.sqrt());
     }
 }
+
+/// A case whose starting design does not load (the file's pitch, 1 mm, makes two tubes
+/// overlap) starts Nelder-Mead from the best design of a coarse grid, and still finds the
+/// evenly spaced row (tolerances as in `lamp_count_and_pitch_of_a_row`).
+#[test]
+fn a_case_that_cannot_start_from_the_scene_starts_from_a_grid() {
+    let dir = lamp_row_box("row-start", 1, 1.0);
+    let scene = load(&dir);
+    let o = options(
+        &[
+            "sources.0.array.count=2..3",
+            "sources.0.array.pitch_mm=1..80",
+        ],
+        Method::NelderMead,
+    );
+    let r = run(&scene, &o);
+    for (c, want, tol) in [(0, 60.0, 5.0), (1, 40.0, 3.5)] {
+        let case = &r.cases[c];
+        assert!(
+            case.termination.contains("started from the best of a grid"),
+            "{}",
+            case.termination
+        );
+        assert!(
+            (case.values[1] - want).abs() < tol,
+            "count {}: pitch {:.2}",
+            c + 2,
+            case.values[1]
+        );
+    }
+}

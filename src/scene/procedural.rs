@@ -32,7 +32,8 @@
 //! (the shape `tools/scenegen` meshes for `direct-lit`), straight slopes (`triangle`) or
 //! parabolas with their vertex under the lamp (`parabola`); its side and end walls rise to
 //! the open top. It is open only along that top rim. A CCFL over the box that comes
-//! closer to its back, walls or top than its radius is an error. The lamp holder is a sheet extruded
+//! beside the box (within its y and z range) that is outside it or closer to its back, walls
+//! or top than its radius is an error. The lamp holder is a sheet extruded
 //! along the lamp, open only at its aperture. Faces are wound towards the lamps (into the
 //! box, towards the holder's axis).
 
@@ -250,8 +251,10 @@ fn check_clearance(
         let Emitter::Ccfl { center, radius, .. } = &s.emitter else {
             continue;
         };
+        // Lamps in the box's slab (its y and z range) must be inside it; lamps above or
+        // beyond its ends belong to other parts.
         let p = *center - origin;
-        if !(p.y >= 0.0 && p.y <= size[1] && p.x > -radius && p.x < size[0] + radius) {
+        if !(p.y >= 0.0 && p.y <= size[1] && p.z >= 0.0 && p.z <= size[2]) {
             continue;
         }
         let clear = prof
@@ -259,6 +262,15 @@ fn check_clearance(
             .map(|w| point_segment([p.x, p.z], w[0], w[1]))
             .chain([p.x, size[0] - p.x, size[2] - p.z])
             .fold(f64::INFINITY, f64::min);
+        if clear < 0.0 {
+            return Err(ctx.err(
+                field,
+                format!(
+                    "source '{}' lies beside the box, outside it ({:.3} mm beyond a wall)",
+                    s.name, -clear
+                ),
+            ));
+        }
         if clear < *radius {
             return Err(ctx.err(
                 field,
@@ -772,6 +784,14 @@ mod tests {
         let m = e(dl_box(6.0, Profile::Triangle, &lamps));
         assert!(
             m.contains("procedural[0].ridge_height_mm: source 'lamp1' has its axis 0.984 mm from"),
+            "{m}"
+        );
+        // A lamp beside the box, beyond its x wall.
+        let (_, mut lamps) = direct_lit();
+        lamps[5].translate(DVec3::new(50.0, 0.0, 0.0));
+        let m = e(dl_box(6.0, Profile::Triangle, &lamps));
+        assert!(
+            m.contains("source 'lamp6' lies beside the box, outside it (16.667 mm beyond a wall)"),
             "{m}"
         );
     }

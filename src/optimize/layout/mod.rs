@@ -236,15 +236,7 @@ fn search_case(
             "no continuous variable: traced once".to_string()
         }
         (false, Method::Grid) => {
-            let k = search.options.grid_points;
-            let axis: Vec<f64> = (0..k).map(|j| j as f64 / (k - 1) as f64).collect();
-            let points: Vec<Vec<f64>> = match free.len() {
-                1 => axis.iter().map(|&a| vec![a]).collect(),
-                _ => axis
-                    .iter()
-                    .flat_map(|&b| axis.iter().map(move |&a| vec![a, b]))
-                    .collect(),
-            };
+            let points = grid(free.len(), search.options.grid_points);
             for z in &points {
                 eval(search, z)?;
             }
@@ -252,6 +244,26 @@ fn search_case(
         }
         (false, _) => {
             let o = search.options;
+            // A start that does not load (the scene's pitch with more lamps than fit)
+            // gives the simplex nothing to follow: start from the best design of a
+            // coarse grid instead (one or two variables).
+            let mut start = scaled.clone();
+            let mut how = String::new();
+            if eval(search, &start)? >= PENALTY && free.len() <= 2 {
+                let mut best: Option<(f64, Vec<f64>)> = None;
+                for z in grid(free.len(), o.grid_points) {
+                    let v = eval(search, &z)?;
+                    if v < PENALTY && best.as_ref().is_none_or(|(b, _)| v < *b) {
+                        best = Some((v, z));
+                    }
+                }
+                if let Some((_, z)) = best {
+                    start = z;
+                    how =
+                        "; started from the best of a grid, the scene's design not loading".into();
+                }
+            }
+            let scaled = start;
             let steps: Vec<f64> = scaled
                 .iter()
                 .map(|z| {
@@ -274,11 +286,15 @@ fn search_case(
                 &settings,
                 &mut |_| {},
             )?;
-            format!("{} after {} iterations", out.termination, out.iterations)
+            format!(
+                "{} after {} iterations{how}",
+                out.termination, out.iterations
+            )
         }
     };
     let (objective, noise, values) =
         case_best.unwrap_or((f64::NAN, f64::NAN, full(search, &scaled)));
+
     Ok(IntegerCase {
         integers: ints.iter().flatten().copied().collect(),
         values,
@@ -287,4 +303,16 @@ fn search_case(
         evaluations: search.history.len() - evaluations,
         termination,
     })
+}
+
+/// The points of a grid of `k` per axis over the unit square (or segment), ends included.
+fn grid(dims: usize, k: usize) -> Vec<Vec<f64>> {
+    let axis: Vec<f64> = (0..k).map(|j| j as f64 / (k - 1) as f64).collect();
+    match dims {
+        1 => axis.iter().map(|&a| vec![a]).collect(),
+        _ => axis
+            .iter()
+            .flat_map(|&b| axis.iter().map(move |&a| vec![a, b]))
+            .collect(),
+    }
 }

@@ -3,12 +3,21 @@
 
 use super::LayoutResult;
 use crate::optimize::scene_edit::{make_paths_absolute, to_toml};
-use crate::output::atomic::StagedDir;
+use crate::output::atomic::OutputSet;
 use crate::scene::Scene;
 use crate::scene::config::SceneFile;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// The names a layout search writes into its folder.
+const OUTPUT_NAMES: &[&str] = &[
+    "optimized.toml",
+    "history.csv",
+    "optimize.json",
+    "initial",
+    "final",
+];
 
 impl LayoutResult {
     /// The best design's scene file: the original with the variables' final values, file
@@ -88,12 +97,12 @@ impl LayoutResult {
             .map_err(|e| anyhow::anyhow!("optimized scene does not parse: {e}"))?;
         Scene::from_file(&file, &dir.join("optimized.toml"))
             .context("the optimized scene does not load")?;
-        let mut staged = StagedDir::new(dir)?;
+        let staged = OutputSet::new(dir, OUTPUT_NAMES)?;
         staged.write_bytes("optimized.toml", toml_text.as_bytes())?;
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
-            run.result().write(&staged.stage_dir(name))?;
+            run.result().write_into(&staged.subdir(name)?)?;
         }
         staged.commit()
     }

@@ -273,7 +273,7 @@ impl DirectLit {
         vec![bx, plate]
     }
 
-    fn scene_toml(&self, triangles: usize) -> String {
+    pub(crate) fn scene_toml(&self, triangles: usize) -> String {
         let reflector = match self.reflector {
             Reflector::Flat => "flat, at z = 0".to_string(),
             Reflector::Ridges { height } => format!(
@@ -406,7 +406,7 @@ angular_bins = [18, 36]
     }
 
     /// The plate's paragraph in the scene file's header.
-    fn plate_note(&self) -> String {
+    pub(crate) fn plate_note(&self) -> String {
         match self.plate {
             Plate::Bulk => format!(
                 "A bulk diffuser

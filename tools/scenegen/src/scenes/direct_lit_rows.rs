@@ -5,10 +5,7 @@
 //! for `blutrace optimize --vary`. Only the diffuser plate is meshed. Same physics as
 //! `direct-lit` (a test traces both).
 
-use super::direct_lit::{
-    BOX_X, BOX_Y, DEPTH, DirectLit, LAMP_POWER_W, LAMP_R, N_PLATE, PLATE_ABSORPTION, PLATE_T,
-    Reflector, WALL_ALBEDO,
-};
+use super::direct_lit::{BOX_X, BOX_Y, DEPTH, DirectLit, LAMP_POWER_W, LAMP_R, PLATE_T, Reflector};
 use super::{GENERATED, trace_table};
 use crate::{
     CCFL_BODY, GenFile, ObjTags, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
@@ -39,10 +36,13 @@ pub fn files() -> Vec<GenFile> {
     let mtl_header =
         format!("{header}\nDisplay colours only: blutrace reads the usemtl names as tags.");
     let parts = [plate];
+    let plate_note = d.plate_note();
     let text = format!(
         "direct-lit-rows: the bundled direct-lit scene (see its scene.toml for the parts and
 their sources) with its six lamps as one source row and its box generated at load.
 {GENERATED}
+
+The diffuser plate (tags diffuser_top, diffuser_back, diffuser_edge): {plate_note}
 
 Parameters for `blutrace optimize --vary` (README, Optimizing the layout):
 - sources.0.center.2: lamp height above the valleys (mm);
@@ -70,28 +70,7 @@ size_mm = {size}
 ridge_height_mm = {height}
 profile = \"triangle\"
 
-[media.pc]
-n = {np}
-absorption_per_mm = {PLATE_ABSORPTION}
-
-[surfaces.box_reflector]
-model = \"lambert\"
-albedo = {WALL_ALBEDO}
-
-[surfaces.diffuser_top]
-model = \"diffuser\"
-inside = \"pc\"
-roughness = {rough}
-
-[surfaces.diffuser_back]
-model = \"diffuser\"
-inside = \"pc\"
-roughness = {rough}
-
-[surfaces.diffuser_edge]
-model = \"dielectric\"
-inside = \"pc\"
-
+{plate}
 [[sources]]
 type = \"ccfl\"
 name = \"lamp\"
@@ -115,8 +94,7 @@ angular_bins = [18, 36]
         pitch = dim(d.pitch),
         size = arr(&[BOX_X, BOX_Y, DEPTH]),
         height = num(height),
-        np = num(N_PLATE),
-        rough = num(d.diffuser_roughness),
+        plate = plate_and_walls(&d),
         center = arr(&[0.5 * BOX_X, 0.5 * BOX_Y, d.lamp_height]),
         r = num(LAMP_R),
         len = num(d.lamp_length()),
@@ -139,4 +117,13 @@ angular_bins = [18, 36]
             write_mtl(&mtl_header, &tags_of(&parts)),
         ),
     ]
+}
+
+/// `direct-lit`'s media and surfaces, as its own scene file writes them (from `[media.pc]`
+/// to its first `[[sources]]`), so both scenes keep one plate and one box model.
+fn plate_and_walls(d: &DirectLit) -> String {
+    let full = d.scene_toml(0);
+    let start = full.find("[media.pc]").expect("direct-lit has [media.pc]");
+    let end = full.find("[[sources]]").expect("direct-lit has sources");
+    full[start..end].trim_end().to_string() + "\n"
 }

@@ -96,6 +96,12 @@ layout() {
   timed "$out/layout-count.log" "$bin" optimize scenes/direct-lit-rows \
     --vary sources.0.array.count=4..8 --vary sources.0.array.pitch_mm=40..110 \
     --photons 200000 --verify-photons 2000000 --out "$out/layout-count"
+  # The edge-lit holder for coupling efficiency, then the dots for the new holder.
+  timed "$out/layout-holder.log" "$bin" optimize scenes/edge-holder \
+    --vary procedural.0.section.radius_mm=2.0..2.5 --objective efficiency \
+    --photons 200000 --verify-photons 2000000 --out "$out/layout-holder"
+  timed "$out/layout-holder-dots.log" "$bin" optimize "$out/layout-holder/optimized.toml" \
+    --method feedback --photons 200000 --verify-photons 2000000 --out "$out/layout-holder-dots"
 }
 
 bench() {

@@ -43,6 +43,7 @@ pub fn all_files() -> Vec<GenFile> {
     let mut files = Vec::new();
     files.extend(scenes::notebook14::files());
     files.extend(scenes::wedge_ccfl::files());
+    files.extend(scenes::edge_holder::files());
     files.extend(scenes::test_slab::files());
     files.extend(scenes::test_slab_edge_lit::files());
     files.extend(scenes::test_two_tags::files());

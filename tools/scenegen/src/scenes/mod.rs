@@ -6,6 +6,7 @@ pub mod cad_reflector;
 pub mod diffusion_lgp;
 pub mod direct_lit;
 pub mod direct_lit_rows;
+pub mod edge_holder;
 pub mod notebook14;
 pub mod phone_led;
 pub mod prism_plate;

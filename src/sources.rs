@@ -9,6 +9,7 @@
 //! radius_mm = 1.0
 //! length_mm = 200.0
 //! power_w = 1.0
+//! body = { model = "lambert", albedo = 0.5 }   # what returning light meets: see `body`
 //!
 //! [[sources]]
 //! type = "led"               # flat rectangle emitting cos^m about its normal
@@ -41,6 +42,7 @@ use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use body::{BodySpec, LampBody};
+use body_shape::Rect;
 use glam::DVec3;
 use intensity::IntensityProfile;
 use serde::{Deserialize, Serialize};
@@ -409,24 +411,14 @@ impl Emitter {
                         let normal = t * phi.cos() + b * phi.sin();
                         (*center + *axis * (f(j) * length) + normal * *radius, normal)
                     }
-                    Emitter::Led {
-                        center,
-                        normal,
-                        u,
-                        width,
-                        height,
-                        ..
-                    }
-                    | Emitter::MeasuredLed {
-                        center,
-                        normal,
-                        u,
-                        width,
-                        height,
-                        ..
-                    } => {
-                        let v = normal.cross(*u);
-                        (*center + *u * (f(i) * width) + v * (f(j) * height), *normal)
+                    Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
+                        let r = self.rect().expect("an LED has a rectangle");
+                        let v = r.normal.cross(r.u);
+                        let (width, height) = (2.0 * r.half_width, 2.0 * r.half_height);
+                        (
+                            r.center + r.u * (f(i) * width) + v * (f(j) * height),
+                            r.normal,
+                        )
                     }
                 });
             }
@@ -437,19 +429,32 @@ impl Emitter {
     /// The distance (mm) from `p` to the emitting surface (the tube's side, or the
     /// rectangle).
     pub fn surface_distance(&self, p: DVec3) -> f64 {
+        if let Emitter::Ccfl {
+            center,
+            axis,
+            radius,
+            length,
+        } = self
+        {
+            let rel = p - *center;
+            let along = rel.dot(*axis);
+            let radial = (rel - *axis * along).length() - radius;
+            let beyond = (along.abs() - 0.5 * length).max(0.0);
+            return radial.hypot(beyond);
+        }
+        let r = self.rect().expect("an LED has a rectangle");
+        let rel = p - r.center;
+        let v = r.normal.cross(r.u);
+        let du = (rel.dot(r.u).abs() - r.half_width).max(0.0);
+        let dv = (rel.dot(v).abs() - r.half_height).max(0.0);
+        rel.dot(r.normal).hypot(du.hypot(dv))
+    }
+
+    /// An LED's emitting rectangle (`None` for a CCFL): the one place the LED kinds'
+    /// shared fields are unpacked.
+    pub fn rect(&self) -> Option<Rect> {
         match self {
-            Emitter::Ccfl {
-                center,
-                axis,
-                radius,
-                length,
-            } => {
-                let rel = p - *center;
-                let along = rel.dot(*axis);
-                let radial = (rel - *axis * along).length() - radius;
-                let beyond = (along.abs() - 0.5 * length).max(0.0);
-                radial.hypot(beyond)
-            }
+            Emitter::Ccfl { .. } => None,
             Emitter::Led {
                 center,
                 normal,
@@ -465,13 +470,13 @@ impl Emitter {
                 width,
                 height,
                 ..
-            } => {
-                let rel = p - *center;
-                let v = normal.cross(*u);
-                let du = (rel.dot(*u).abs() - 0.5 * width).max(0.0);
-                let dv = (rel.dot(v).abs() - 0.5 * height).max(0.0);
-                rel.dot(*normal).hypot(du.hypot(dv))
-            }
+            } => Some(Rect {
+                center: *center,
+                normal: *normal,
+                u: *u,
+                half_width: 0.5 * width,
+                half_height: 0.5 * height,
+            }),
         }
     }
 }

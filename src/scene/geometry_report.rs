@@ -211,29 +211,15 @@ fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
             let along = rel.dot(*axis);
             along.abs() < length / 2.0 - eps && (rel - *axis * along).length() < radius - eps
         }),
-        Emitter::Led {
-            center,
-            normal,
-            u,
-            width,
-            height,
-            ..
-        }
-        | Emitter::MeasuredLed {
-            center,
-            normal,
-            u,
-            width,
-            height,
-            ..
-        } => {
+        Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
+            let r = e.rect().expect("an LED has a rectangle");
             let plane = Plane {
-                origin: *center,
-                u: *u,
-                v: normal.cross(*u),
-                n: *normal,
+                origin: r.center,
+                u: r.u,
+                v: r.normal.cross(r.u),
+                n: r.normal,
             };
-            let half = [width / 2.0, height / 2.0];
+            let half = [r.half_width, r.half_height];
             plane.cut_meets(c, half.map(|h| -h), half, eps)
         }
     }

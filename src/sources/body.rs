@@ -28,7 +28,7 @@
 //! are an LED's silicone dome, its lead frame and the die's own reflectance map.
 
 use super::Emitter;
-use super::body_shape::{BodyHit, BodyShape, Rect};
+use super::body_shape::{BodyHit, BodyShape};
 use crate::geometry::Ray;
 use crate::optics::absorber::AbsorberSpec;
 use crate::optics::lambert::LambertSpec;
@@ -141,46 +141,26 @@ impl LampBody {
     /// The body of `emitter`: its tube, its emitting rectangle, or a box package
     /// `package_depth` deep behind that rectangle.
     pub fn new(emitter: &Emitter, model: SurfaceModel, package_depth: Option<f64>) -> Self {
-        let shape = match emitter {
-            Emitter::Ccfl {
-                center,
-                axis,
-                radius,
-                length,
-            } => BodyShape::Cylinder {
+        let shape = match (emitter, emitter.rect()) {
+            (
+                Emitter::Ccfl {
+                    center,
+                    axis,
+                    radius,
+                    length,
+                },
+                _,
+            ) => BodyShape::Cylinder {
                 center: *center,
                 axis: *axis,
                 radius: *radius,
                 half_length: 0.5 * length,
             },
-            Emitter::Led {
-                center,
-                normal,
-                u,
-                width,
-                height,
-                ..
-            }
-            | Emitter::MeasuredLed {
-                center,
-                normal,
-                u,
-                width,
-                height,
-                ..
-            } => {
-                let front = Rect {
-                    center: *center,
-                    normal: *normal,
-                    u: *u,
-                    half_width: 0.5 * width,
-                    half_height: 0.5 * height,
-                };
-                match package_depth {
-                    Some(depth) => BodyShape::Package { front, depth },
-                    None => BodyShape::Rectangle(front),
-                }
-            }
+            (_, Some(front)) => match package_depth {
+                Some(depth) => BodyShape::Package { front, depth },
+                None => BodyShape::Rectangle(front),
+            },
+            (_, None) => unreachable!("only a CCFL has no rectangle"),
         };
         Self { shape, model }
     }

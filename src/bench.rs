@@ -145,11 +145,7 @@ pub fn in_guide_table(
         if solid.contains(p, 1e-6) {
             rays.push(Ray::new(
                 p,
-                sampling::around(
-                    glam::DVec3::Z,
-                    2.0 * rng.uniform() - 1.0,
-                    std::f64::consts::TAU * rng.uniform(),
-                ),
+                sampling::around(glam::DVec3::Z, 2.0 * rng.uniform() - 1.0, rng.uniform()),
             ));
         }
     }

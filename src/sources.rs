@@ -353,8 +353,8 @@ impl Source {
             } => {
                 // Uniform point (2 pi h1, l h2) on the tube, Lambertian direction (eq. 1).
                 let (t, b) = orthonormal_basis(*axis);
-                let phi = TAU * rng.uniform();
-                let n = t * phi.cos() + b * phi.sin();
+                let (cos_p, sin_p) = sampling::turn(rng.uniform());
+                let n = t * cos_p + b * sin_p;
                 let along = (rng.uniform() - 0.5) * length;
                 let p = *center + *axis * along + n * *radius;
                 (
@@ -384,7 +384,7 @@ impl Source {
             } => {
                 let p = rectangle_point(*center, *normal, *u, (*width, *height), rng);
                 let theta = profile.sample_theta(rng.uniform());
-                let d = sampling::around(*normal, theta.cos(), TAU * rng.uniform());
+                let d = sampling::around(*normal, theta.cos(), rng.uniform());
                 (Ray::new(p, d), *normal)
             }
         }

@@ -299,8 +299,12 @@ impl Ledger {
 
     /// Book the weight lost between `before` and `after` at `sink`.
     pub(crate) fn lose(sink: &mut ExactSum, before: f64, after: f64) {
-        sink.add(before);
-        sink.add(-after);
+        // Nothing lost (every analog scattering): adding w and -w would leave the sum
+        // exactly as it is (rounding is symmetric), so skip the two conversions.
+        if before != after {
+            sink.add(before);
+            sink.add(-after);
+        }
     }
 
     pub(crate) fn merge(&mut self, o: &Ledger) {

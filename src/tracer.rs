@@ -19,6 +19,7 @@
 mod flight;
 
 use crate::accel::Accel;
+use crate::accel::convex::ConvexSolid;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
@@ -82,7 +83,10 @@ impl Tracer<'_> {
             let true_ray = p.ray.true_ray();
             let surf = self.nearest_surface(p, &true_ray);
             let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
-            let detected = scene.detector.intersect(&true_ray, t_surface);
+            let detected = match self.convex_solid(p) {
+                Some(solid) if solid.clear_of_target => None,
+                _ => scene.detector.intersect(&true_ray, t_surface),
+            };
             let t_next = detected.map_or(t_surface, |(t, _)| t);
             match self.cross_medium(p, &true_ray, t_next, rng, &mut out.ledger) {
                 Flight::Absorbed => return Fate::AbsorbedInMedium(p.medium),
@@ -145,14 +149,22 @@ impl Tracer<'_> {
         self.nearest_body(p, t_mesh).or(mesh)
     }
 
+    /// The convex solid `p` travels in, when the fast path is on and its medium has one.
+    fn convex_solid(&self, p: &Photon) -> Option<&ConvexSolid> {
+        self.scene.convex_solid(p.medium).filter(|_| self.convex)
+    }
+
     /// The triangle `p` reaches first along `true_ray`.
     fn nearest_triangle(&self, p: &Photon, true_ray: &Ray) -> Option<SurfaceHit> {
         let scene = self.scene;
-        match scene.convex_solid(p.medium).filter(|_| self.convex) {
-            // The convex path needs no nudge: it finds the exit from the true position.
-            Some(solid) => solid.exit(&scene.mesh, true_ray).map(|h| {
-                let n = self.normals[h.prim as usize];
-                scene.mesh.refine_hit(true_ray, h.prim, h.t, n)
+        match self.convex_solid(p) {
+            // The convex path needs no nudge and no refinement: it intersects the exact
+            // f64 face planes from the true position.
+            Some(solid) => solid.exit(&scene.mesh, true_ray).map(|h| SurfaceHit {
+                t: h.t,
+                prim: h.prim,
+                point: true_ray.at(h.t),
+                normal: self.normals[h.prim as usize],
             }),
             None => self.accel.intersect(&p.ray.search, f64::INFINITY).map(|h| {
                 let n = self.normals[h.prim as usize];
@@ -167,11 +179,14 @@ impl Tracer<'_> {
     /// distance ~0); distances are measured from the true position, as for triangles.
     fn nearest_body(&self, p: &Photon, t_max: f64) -> Option<Hit> {
         let mut best: Option<Hit> = None;
+        // The search ray starts one spawn offset off the true position, so a body within
+        // `t_max` of the true position lies within `t_max + eps` along the search ray.
+        let reach = t_max + 2.0 * self.scene.spawn_eps;
         for (i, source, body) in self.scene.sources.bodies() {
             if source.medium != p.medium {
                 continue;
             }
-            let Some(h) = body.hit(&p.ray.search, f64::INFINITY) else {
+            let Some(h) = body.hit(&p.ray.search, reach) else {
                 continue;
             };
             let point = p.ray.search.at(h.t);

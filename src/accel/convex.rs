@@ -31,6 +31,10 @@ pub struct ConvexSolid {
     /// Plane normals and offsets packed for the exit loop.
     normals: Vec<DVec3>,
     offsets: Vec<f64>,
+    /// True when the whole solid lies strictly on one side of the scene's target plane
+    /// (set by the scene): a photon inside can then never cross the target before it
+    /// leaves, and the tracer skips that test.
+    pub clear_of_target: bool,
 }
 
 impl ConvexSolid {
@@ -68,6 +72,7 @@ impl ConvexSolid {
             planes,
             normals,
             offsets,
+            clear_of_target: false,
         })
     }
 
@@ -168,11 +173,8 @@ mod tests {
         let mut rng = crate::rng::PhotonRng::new(1, 0);
         for _ in 0..10_000 {
             let o = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 0.98 + 0.01;
-            let d = crate::optics::sampling::around(
-                DVec3::Z,
-                2.0 * rng.uniform() - 1.0,
-                std::f64::consts::TAU * rng.uniform(),
-            );
+            let d =
+                crate::optics::sampling::around(DVec3::Z, 2.0 * rng.uniform() - 1.0, rng.uniform());
             let ray = Ray::new(o, d);
             let a = solid.exit(&mesh, &ray).unwrap();
             let b = brute.intersect(&ray, f64::INFINITY).unwrap();

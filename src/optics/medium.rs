@@ -34,7 +34,6 @@ use anyhow::Result;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::f64::consts::TAU;
 use std::sync::Arc;
 
 /// Index of a medium in the scene's medium table (0 is the ambient medium, air).
@@ -92,7 +91,7 @@ impl Scattering {
     /// uniform numbers.
     pub fn scatter(&self, dir: DVec3, u1: f64, u2: f64) -> DVec3 {
         match &self.table {
-            Some(t) => sampling::around(dir, t.cos_theta(u1), TAU * u2),
+            Some(t) => sampling::around(dir, t.cos_theta(u1), u2),
             None => phase::scatter(dir, self.anisotropy, u1, u2),
         }
     }

@@ -35,7 +35,7 @@ pub fn hg_cos_theta(g: f64, u: f64) -> f64 {
 /// The direction after scattering a photon travelling along unit `dir`, from two uniform
 /// numbers: polar angle from the phase function, azimuth uniform.
 pub fn scatter(dir: DVec3, g: f64, u1: f64, u2: f64) -> DVec3 {
-    sampling::around(dir, hg_cos_theta(g, u1), TAU * u2)
+    sampling::around(dir, hg_cos_theta(g, u1), u2)
 }
 
 /// Fine cells over 0..180 degrees for sampling a [`PhaseTable`]: the density is taken as

@@ -292,7 +292,7 @@ fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
             if m == 0 || prims.is_empty() {
                 return None;
             }
-            let solid = ConvexSolid::from_triangles(mesh, &prims, tol)?;
+            let mut solid = ConvexSolid::from_triangles(mesh, &prims, tol)?;
             let others_inside = (0..mesh.len() as u32).filter(|&p| !encloses(p)).any(|p| {
                 let c = mesh.corners(p);
                 let centroid = (c[0] + c[1] + c[2]) / 3.0;
@@ -303,6 +303,10 @@ fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
                 [0.0, 1.0].map(|b| d.origin + d.u * (a * d.size[0]) + d.v * (b * d.size[1]))
             });
             let detector_inside = corners.iter().flatten().any(|&v| solid.contains(v, tol));
+            let side = |v: DVec3| (v - d.origin).dot(d.normal());
+            let vertices = || prims.iter().flat_map(|&p| mesh.corners(p));
+            solid.clear_of_target =
+                vertices().all(|v| side(v) < -tol) || vertices().all(|v| side(v) > tol);
             (!others_inside && !detector_inside).then_some(solid)
         })
         .collect()

@@ -177,6 +177,10 @@ fn cylinder_entry(ray: &Ray, c: DVec3, axis: DVec3, r: f64, h: f64) -> Option<Bo
     let a = d_perp.length_squared();
     let b = o_perp.dot(d_perp);
     let cc = o_perp.length_squared() - r * r;
+    if cc > 0.0 && (b >= 0.0 || b * b < a * cc) {
+        // Outside the tube and moving away from it, or passing it by: no square root.
+        return None;
+    }
     let tube = if a == 0.0 {
         (cc <= 0.0).then_some(Slab {
             t_in: f64::NEG_INFINITY,

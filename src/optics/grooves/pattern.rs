@@ -454,8 +454,7 @@ mod tests {
         for i in 0..20_000u64 {
             let mut rng = PhotonRng::new(3, i);
             let u = rng.uniform();
-            let phi = std::f64::consts::TAU * rng.uniform();
-            let dir = crate::optics::sampling::around(DVec3::Z, 2.0 * u - 1.0, phi);
+            let dir = crate::optics::sampling::around(DVec3::Z, 2.0 * u - 1.0, rng.uniform());
             if dir.z == 0.0 {
                 continue;
             }
@@ -569,9 +568,9 @@ mod tests {
             for i in 0..4000u64 {
                 let mut rng = PhotonRng::new(3, i);
                 let cos_t = 2.0 * rng.uniform() - 1.0;
-                let phi = std::f64::consts::TAU * rng.uniform();
+                let turn = rng.uniform();
                 let axis = DVec3::new(0.3, 0.1, 1.0).normalize();
-                let dir = crate::optics::sampling::around(axis, cos_t, phi);
+                let dir = crate::optics::sampling::around(axis, cos_t, turn);
                 let point = DVec3::new(1.0 + 18.0 * rng.uniform(), 0.0, 0.0);
                 let normal = if i % 2 == 0 { DVec3::NEG_Z } else { DVec3::Z };
                 let (mut r1, mut r2) = (PhotonRng::new(77, i), PhotonRng::new(77, i));

@@ -58,6 +58,9 @@ struct Photon {
     ray: SpawnedRay,
     medium: MediumId,
     weight: f64,
+    /// Analog estimator: the optical depth of clear-medium absorption the photon has
+    /// left (an Exp(1) draw, made on its first absorbing segment; negative until then).
+    absorption_depth: f64,
 }
 
 impl Tracer<'_> {
@@ -69,6 +72,7 @@ impl Tracer<'_> {
             ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
             medium: e.medium,
             weight: 1.0,
+            absorption_depth: -1.0,
         };
         out.ledger.photons += 1;
         out.ledger.emitted.add(1.0);
@@ -250,8 +254,20 @@ impl Tracer<'_> {
             return Flight::Reached;
         }
         match self.estimator {
-            Estimator::Analog if -(1.0 - rng.uniform()).ln() / a >= t => Flight::Reached,
-            Estimator::Analog => Flight::Absorbed,
+            Estimator::Analog => {
+                // Absorption is memoryless: one exponential depth per photon, spent
+                // segment by segment (a t each), has the law of a fresh free path per
+                // segment, without a logarithm and a random draw on every segment.
+                if p.absorption_depth < 0.0 {
+                    p.absorption_depth = -(1.0 - rng.uniform()).ln();
+                }
+                let spent = a * t;
+                if spent > p.absorption_depth {
+                    return Flight::Absorbed;
+                }
+                p.absorption_depth -= spent;
+                Flight::Reached
+            }
             Estimator::Weighted => {
                 // An escaping photon (t infinite) loses nothing more inside this medium.
                 let w = if t.is_finite() {

@@ -482,7 +482,7 @@ fn tabulated_phase_function_directions_follow_the_table() {
         &grid,
         &mut |i| {
             let (u1, u2) = uniforms(43, i);
-            Some(sampling::around(axis, table.cos_theta(u1), TAU * u2))
+            Some(sampling::around(axis, table.cos_theta(u1), u2))
         },
         &|w: DVec3| raw(w.dot(axis).clamp(-1.0, 1.0).acos()) / norm,
         16,

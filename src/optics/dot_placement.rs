@@ -144,22 +144,31 @@ impl DotPattern {
     /// The cell (column `i`, row `j`) whose lattice point is nearest to `q` (face
     /// coordinates): the cell `q` lies in.
     pub fn nearest_cell(&self, q: DVec2) -> (i64, i64) {
+        let (i, j, _) = self.nearest_cell_centre(q);
+        (i, j)
+    }
+
+    /// [`DotPattern::nearest_cell`] and that cell's centre (one lookup per ink test).
+    fn nearest_cell_centre(&self, q: DVec2) -> (i64, i64, DVec2) {
         let p = self.pitch;
         match self.lattice {
-            Lattice::Square => ((q.x / p).floor() as i64, (q.y / p).floor() as i64),
+            Lattice::Square => {
+                let (i, j) = ((q.x / p).floor() as i64, (q.y / p).floor() as i64);
+                (i, j, self.cell_centre(i, j))
+            }
             Lattice::Hex => {
+                // The two rows around q; in each, the column nearest q; the nearer wins
+                // (the first on a tie).
                 let j0 = (q.y / self.row_spacing() - 0.5).floor() as i64;
-                [j0, j0 + 1]
-                    .map(|j| {
-                        let shift = if j.rem_euclid(2) == 1 { 0.5 * p } else { 0.0 };
-                        (((q.x - shift) / p - 0.5).round() as i64, j)
-                    })
-                    .into_iter()
-                    .min_by(|a, b| {
-                        let d = |c: &(i64, i64)| self.cell_centre(c.0, c.1).distance_squared(q);
-                        d(a).total_cmp(&d(b))
-                    })
-                    .expect("two candidates")
+                let candidate = |j: i64| {
+                    let shift = if j.rem_euclid(2) == 1 { 0.5 * p } else { 0.0 };
+                    let i = ((q.x - shift) / p - 0.5).round() as i64;
+                    let c = self.cell_centre(i, j);
+                    (i, j, c, c.distance_squared(q))
+                };
+                let (a, b) = (candidate(j0), candidate(j0 + 1));
+                let nearer = if b.3 < a.3 { b } else { a };
+                (nearer.0, nearer.1, nearer.2)
             }
         }
     }
@@ -259,7 +268,13 @@ impl DotPattern {
         let q = self.face_coords(p);
         let inside = |d: PlacedDot| q.distance_squared(d.centre) < d.radius * d.radius;
         match self.placement {
-            Placement::Lattice | Placement::Jittered => {
+            Placement::Lattice => {
+                // As `cell_dot` places it, compared by squared radius (no square root).
+                let (_, _, c) = self.nearest_cell_centre(q);
+                let density = self.density_at_point(c);
+                q.distance_squared(c) < self.lattice.dot_radius_squared(self.pitch, density)
+            }
+            Placement::Jittered => {
                 let (i, j) = self.nearest_cell(q);
                 inside(self.cell_dot(i, j))
             }

@@ -196,7 +196,12 @@ impl Lattice {
 
     /// Radius of a round dot covering the fraction `density` of its cell.
     pub fn dot_radius(self, pitch: f64, density: f64) -> f64 {
-        (density.max(0.0) * self.cell_area(pitch) / PI).sqrt()
+        self.dot_radius_squared(pitch, density).sqrt()
+    }
+
+    /// The square of [`Lattice::dot_radius`] (what an ink test compares with).
+    pub fn dot_radius_squared(self, pitch: f64, density: f64) -> f64 {
+        density.max(0.0) * self.cell_area(pitch) / PI
     }
 }
 

@@ -5,10 +5,24 @@ use std::path::Path;
 
 pub(super) fn bench(
     scene: &Path,
+    box_scene: &Path,
     photons: u64,
     threads: Option<usize>,
     repeat: usize,
 ) -> Result<()> {
+    let rows = crate::bench::reference_table(box_scene, photons, threads, repeat)?;
+    println!(
+        "| {}, {photons} photons | photons/s | interactions/s | ratio to the reference |",
+        box_scene.display()
+    );
+    println!("|---|---:|---:|---:|");
+    for r in rows {
+        println!(
+            "| {} | {:.0} | {:.0} | {:.3} |",
+            r.tracer, r.photons_per_s, r.interactions_per_s, r.ratio_to_reference
+        );
+    }
+    println!();
     println!(
         "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
     );

@@ -41,6 +41,10 @@ enum Command {
         /// The notebook scene folder.
         #[arg(long, default_value = "scenes/notebook14")]
         scene: PathBuf,
+        /// The box-guide scene folder of the speed-of-light table (default: `bench-box`
+        /// beside the notebook scene's folder).
+        #[arg(long)]
+        box_scene: Option<PathBuf>,
         /// Rounds per timing (each round measures every configuration once; medians).
         #[arg(long, default_value_t = 3)]
         repeat: usize,
@@ -98,8 +102,13 @@ impl Command {
                 photons,
                 threads,
                 scene,
+                box_scene,
                 repeat,
-            } => bench::bench(&scene, photons, threads, repeat),
+            } => {
+                let box_scene = box_scene
+                    .unwrap_or_else(|| scene.parent().unwrap_or(Path::new(".")).join("bench-box"));
+                bench::bench(&scene, &box_scene, photons, threads, repeat)
+            }
             Command::Check { scene, json } => check::check(&scene_path(&scene), json),
         }
     }

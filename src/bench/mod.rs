@@ -2,8 +2,14 @@
 //! run (never a pass/fail timing).
 //!
 //! ```text
-//! blutrace bench [--photons N] [--threads T] [--repeat R]
+//! blutrace bench [--photons N] [--threads T] [--repeat R] [--scene DIR] [--box-scene DIR]
 //! ```
+//!
+//! First, the speed of light: on the box-guide scene (`scenes/bench-box`), blutrace
+//! (auto backend, convex path) against a hand-written kernel of the same physics
+//! ([`reference`], built from the same loaded scene), the same photons on the same
+//! threads, timed in interleaved rounds; the ratio says how far blutrace's general path
+//! is from what the physics costs.
 //!
 //! Scenes: `scenes/notebook14` as bundled, and the same scene with its lamp reflectors
 //! split into about 540k triangles (same surfaces, so the same physics). Every timing is
@@ -16,6 +22,9 @@
 //! per-hit code. A last table gives the
 //! error reached in a fixed tracing time per backend and estimator, with the figure of
 //! merit `1 / (error^2 * seconds)`.
+
+pub mod box_scene;
+pub mod reference;
 
 use crate::accel::{self, Accel, BackendChoice};
 use crate::geometry::Ray;
@@ -46,6 +55,78 @@ pub struct BenchRow {
     pub interactions_per_s: f64,
     /// photons_per_s over that of obvhs without the convex path, same scene.
     pub ratio_to_obvhs: f64,
+}
+
+/// One row of the speed-of-light table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SpeedRow {
+    /// What traced: blutrace (its backend) or the reference kernel.
+    pub tracer: String,
+    /// Photons per second.
+    pub photons_per_s: f64,
+    /// Surface interactions per second.
+    pub interactions_per_s: f64,
+    /// photons_per_s over the reference kernel's.
+    pub ratio_to_reference: f64,
+}
+
+/// blutrace (auto backend, convex path on) and the reference kernel ([`reference`]) on
+/// the box-guide scene in `box_dir`: the same photons of seed 1 on the same `threads`,
+/// `repeat` rounds each timing both in turn (medians). blutrace's rate is its run's
+/// (tracing and per-round metrics, without loading); the reference's, its tracing. Rows:
+/// blutrace, then the reference.
+pub fn reference_table(
+    box_dir: &Path,
+    photons: u64,
+    threads: Option<usize>,
+    repeat: usize,
+) -> Result<Vec<SpeedRow>> {
+    let scene = Scene::load(&box_dir.join("scene.toml"))?;
+    let kernel = reference::Reference::new(&scene)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?;
+    let o = RunOptions {
+        photons,
+        seed: 1,
+        threads,
+        backend: BackendChoice::Auto,
+        convex: true,
+        ..RunOptions::default()
+    };
+    let (mut blutrace, mut hand) = (Vec::new(), Vec::new());
+    let mut backend = "";
+    for _ in 0..repeat.max(1) {
+        let r = run::trace(&scene, &o, &|_| {})?;
+        let s = r.summary();
+        blutrace.push((s.photons_per_s, s.interactions_per_s));
+        backend = r.backend;
+        let start = Instant::now();
+        let c = pool.install(|| kernel.trace(1, photons));
+        let t = start.elapsed().as_secs_f64();
+        hand.push((c.photons as f64 / t, c.interactions as f64 / t));
+    }
+    let med = |v: &[(f64, f64)]| {
+        (
+            median(v.iter().map(|r| r.0).collect()),
+            median(v.iter().map(|r| r.1).collect()),
+        )
+    };
+    let (b, h) = (med(&blutrace), med(&hand));
+    Ok(vec![
+        SpeedRow {
+            tracer: format!("blutrace ({backend}, convex path)"),
+            photons_per_s: b.0,
+            interactions_per_s: b.1,
+            ratio_to_reference: b.0 / h.0,
+        },
+        SpeedRow {
+            tracer: "reference kernel (f32, analytic planes)".into(),
+            photons_per_s: h.0,
+            interactions_per_s: h.1,
+            ratio_to_reference: 1.0,
+        },
+    ])
 }
 
 /// Backends available here, obvhs first.
@@ -274,6 +355,26 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn speed_of_light_table_has_blutrace_then_the_reference() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bench-box");
+        let rows = reference_table(&dir, 4096, Some(1), 2).unwrap();
+        assert_eq!(rows.len(), 2);
+        assert!(rows[0].tracer.starts_with("blutrace ("));
+        assert!(rows[1].tracer.starts_with("reference kernel"));
+        assert_eq!(rows[1].ratio_to_reference, 1.0);
+        assert_eq!(
+            rows[0].ratio_to_reference,
+            rows[0].photons_per_s / rows[1].photons_per_s
+        );
+        for r in &rows {
+            assert!(r.photons_per_s > 0.0 && r.interactions_per_s > r.photons_per_s);
+        }
+        let notebook = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/notebook14");
+        let e = reference_table(&notebook, 4096, Some(1), 1).unwrap_err();
+        assert!(e.to_string().contains("box-guide scenes"), "{e}");
+    }
 
     #[test]
     fn tables_have_every_configuration_and_obvhs_as_reference() {

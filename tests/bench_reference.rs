@@ -7,7 +7,8 @@
 //! - the fraction of photons with each fate (detected = the extraction efficiency,
 //!   absorbed by the ink, by the sheet, in the PMMA, by the strip's body, escaped,
 //!   killed): binomial, `SE = sqrt(p1 (1 - p1) / N1 + p2 (1 - p2) / N2)`;
-//! - the fraction detected in each of 6 bands along the guide (20 mm each): the same;
+//! - the fraction detected in each of 6 bands along the guide (20 mm each), and within
+//!   30 degrees of the target's normal: the same;
 //! - interactions per photon: `SE = s sqrt(1/N1 + 1/N2)`, `s^2` the per-photon variance
 //!   of the interaction count measured by the reference (under the hypothesis tested,
 //!   both have the same distribution; blutrace keeps no per-photon squares).
@@ -53,6 +54,7 @@ struct Traced {
     photons: f64,
     fates: Vec<(&'static str, f64)>,
     bands: Vec<f64>,
+    near_normal: f64,
     interactions: f64,
 }
 
@@ -69,6 +71,13 @@ fn blutrace(scene: &Scene, dots_tag: usize, sheet_tag: usize) -> Traced {
         .map(|t| l.absorbed_by_surface[t].value())
         .sum();
     assert_eq!(other_surfaces, 0.0, "only ink and sheet absorb");
+    // Angular bins: theta fastest, 90 / nt degrees each.
+    let nt = scene.detector.angular_bins[0];
+    assert_eq!(nt % 3, 0, "30 degrees is a bin edge");
+    let near_normal = (r.tally.angular.bins.iter().enumerate())
+        .filter(|(i, _)| i % nt < nt / 3)
+        .map(|(_, b)| b.sum.value())
+        .sum();
     let nx = scene.detector.bins[0];
     let mut bands = vec![0.0; BANDS];
     for (i, b) in r.tally.flux.bins.iter().enumerate() {
@@ -92,6 +101,7 @@ fn blutrace(scene: &Scene, dots_tag: usize, sheet_tag: usize) -> Traced {
             ("killed", l.killed.value()),
         ],
         bands,
+        near_normal,
         interactions: l.interactions as f64,
     }
 }
@@ -117,6 +127,7 @@ fn reference(scene: &Scene) -> (Traced, Counts) {
             ("killed", c.killed as f64),
         ],
         bands,
+        near_normal: c.detected_near_normal as f64,
         interactions: c.interactions as f64,
     };
     (t, c)
@@ -133,6 +144,13 @@ fn compare(b: &Traced, (r, c): &(Traced, Counts)) -> Vec<Row> {
         let name = format!("detected in band {k} (x {}..{} mm)", 20 * k, 20 * (k + 1));
         rows.push(proportion(&name, *kb, b.photons, *kr, r.photons));
     }
+    rows.push(proportion(
+        "detected within 30 deg of the normal",
+        b.near_normal,
+        b.photons,
+        r.near_normal,
+        r.photons,
+    ));
     let n = r.photons;
     let mean = r.interactions / n;
     let var = (c.interactions_sq as f64 / n - mean * mean) * n / (n - 1.0);

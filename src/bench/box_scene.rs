@@ -262,10 +262,10 @@ impl BoxScene {
             face_area[f] += 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).length();
         }
         let ext = hi - lo;
-        for f in 0..6 {
+        for (f, area) in face_area.iter().enumerate() {
             let (k1, k2) = AaRect::others(f / 2);
             let want = ext[k1] * ext[k2];
-            if (face_area[f] - want).abs() > 1e-9 * want.max(1.0) {
+            if (area - want).abs() > 1e-9 * want.max(1.0) {
                 bail!(refuse(
                     scene,
                     "the guide's faces do not close an axis-aligned box"

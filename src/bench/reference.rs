@@ -43,6 +43,9 @@ use rayon::prelude::*;
 /// Photons per work unit, as blutrace's.
 const CHUNK: u64 = 4096;
 
+/// cos 30 degrees: detections closer to the normal are counted apart.
+const COS_30: f32 = 0.866_025_4;
+
 /// What a traced batch of photons did: fates (each photon has exactly one), interactions
 /// and the flux bins.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -51,6 +54,8 @@ pub struct Counts {
     pub photons: u64,
     /// Reached the target plane.
     pub detected: u64,
+    /// Of those, the ones within 30 degrees of its normal (a coarse angular check).
+    pub detected_near_normal: u64,
     /// Absorbed by the ink of the dots.
     pub absorbed_by_ink: u64,
     /// Absorbed by the sheet.
@@ -82,6 +87,7 @@ impl Counts {
     fn merge(mut self, o: Counts) -> Counts {
         self.photons += o.photons;
         self.detected += o.detected;
+        self.detected_near_normal += o.detected_near_normal;
         self.absorbed_by_ink += o.absorbed_by_ink;
         self.absorbed_by_sheet += o.absorbed_by_sheet;
         self.absorbed_in_medium += o.absorbed_in_medium;
@@ -108,7 +114,8 @@ impl Counts {
 
 /// How one photon ended.
 enum Fate {
-    Detected(usize),
+    /// In this flux bin, within 30 degrees of the normal or not.
+    Detected(usize, bool),
     Ink,
     Sheet,
     Medium,
@@ -171,8 +178,9 @@ impl Reference {
         c.interactions += u64::from(n);
         c.interactions_sq += u128::from(n) * u128::from(n);
         match fate {
-            Fate::Detected(bin) => {
+            Fate::Detected(bin, near_normal) => {
                 c.detected += 1;
+                c.detected_near_normal += u64::from(near_normal);
                 c.flux[bin] += 1;
             }
             Fate::Ink => c.absorbed_by_ink += 1,
@@ -219,7 +227,9 @@ impl Reference {
             }
             let (t, struck) = self.nearest_in_air(p, d);
             if let Some(bin) = self.detected(p, d, t) {
-                return (Fate::Detected(bin), n);
+                let g = &s.target;
+                let near_normal = d[g.rect.axis] * g.normal_sign > COS_30;
+                return (Fate::Detected(bin, near_normal), n);
             }
             let Some(struck) = struck else {
                 return (Fate::Escaped, n);

@@ -6,8 +6,8 @@
 
 use super::{GENERATED, trace_table};
 use crate::{
-    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
+    write_mtl, write_obj,
 };
 
 /// Guide size (x along the light, y along the lit edge, z thickness) (mm); the guide spans

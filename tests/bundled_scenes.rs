@@ -20,6 +20,7 @@ use std::sync::Arc;
 /// Scenes that must be bundled (folders below `scenes/`).
 const EXPECTED: &[&str] = &[
     "notebook14",
+    "bench-box",
     "wedge-ccfl",
     "test/slab",
     "test/slab-edge-lit",

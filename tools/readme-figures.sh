@@ -104,6 +104,8 @@ layout() {
     --method feedback --photons 200000 --verify-photons 2000000 --out "$out/layout-holder-dots"
 }
 
+# Every table of the README's "Backends" section: first blutrace against the reference
+# kernel on scenes/bench-box (speed of light), then the backends on notebook14.
 bench() {
   "$bin" bench --photons 200000 >"$out/bench.log" 2>&1
 }

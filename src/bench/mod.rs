@@ -7,7 +7,7 @@
 //!
 //! First, the speed of light: on the box-guide scene (`scenes/bench-box`), blutrace
 //! (auto backend, convex path) against a hand-written kernel of the same physics
-//! ([`reference`], built from the same loaded scene), the same photons on the same
+//! ([`reference`](mod@reference), built from the same loaded scene), the same photons on the same
 //! threads, timed in interleaved rounds; the ratio says how far blutrace's general path
 //! is from what the physics costs.
 //!
@@ -70,7 +70,7 @@ pub struct SpeedRow {
     pub ratio_to_reference: f64,
 }
 
-/// blutrace (auto backend, convex path on) and the reference kernel ([`reference`]) on
+/// blutrace (auto backend, convex path on) and the reference kernel ([`reference`](mod@reference)) on
 /// the box-guide scene in `box_dir`: the same photons of seed 1 on the same `threads`,
 /// `repeat` rounds each timing both in turn (medians). blutrace's rate is its run's
 /// (tracing and per-round metrics, without loading); the reference's, its tracing. Rows:

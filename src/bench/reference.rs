@@ -201,6 +201,9 @@ impl Reference {
     }
 
     /// One photon from emission to its fate; also its number of interactions.
+    ///
+    /// One function on purpose: split into steps over a photon struct (the same
+    /// arithmetic, the same counts) it ran 20 % slower, and this is the speed of light.
     fn follow(&self, rng: &mut Rng) -> (Fate, u32) {
         let s = &self.s;
         let strip = &s.strip;

@@ -254,6 +254,9 @@ impl Tracer<'_> {
             return Flight::Reached;
         }
         match self.estimator {
+            // An escaping photon (t infinite) leaves the scene: nothing more is absorbed
+            // here, under either estimator.
+            Estimator::Analog if t.is_infinite() => Flight::Reached,
             Estimator::Analog => {
                 // Absorption is memoryless: one exponential depth per photon, spent
                 // segment by segment (a t each), has the law of a fresh free path per

@@ -239,8 +239,9 @@ Chosen as typical of a phone (lengths in mm):
   the edge face). {LED_POWER_W} W (and {lm} lm) each. Intensity profile: led.ies (LM-63-2002,
   type C, one horizontal angle, i.e. rotationally symmetric about the window's normal);
   led.csv holds the same table. ILLUSTRATIVE: a shallow batwing, wider than Lambertian,
-  peaking near 35 degrees; not a measured product. Sources are not geometry: photons
-  returning to the LEDs pass through them.
+  peaking near 35 degrees; not a measured product. Each LED has a body (its `body` entry
+  below): photons returning to an LED meet its emitting window (diffuse, albedo 0.8) or,
+  from behind, its absorbing package.
 - LED housing (tag led_housing): a white box round the LED row, x {xh}..0, y 0..{W},
   z {zs}..{T}: back wall, top (level with the front face, covering the LEDs and the air
   gap), end caps; the reflector sheet closes it from below. Phong: reflectance 0.9,

@@ -220,6 +220,26 @@ fn jittered_dots_cover_the_density_without_overlap() {
 }
 
 #[test]
+fn exports_refuse_a_pitch_that_would_print_billions_of_dots() {
+    let face = [[
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(300.0, 0.0, 0.0),
+        DVec3::new(0.0, 200.0, 0.0),
+    ]];
+    let mut fine = pattern(Lattice::Square, Placement::Lattice, 0, 0.3);
+    fine.pitch = 1e-3; // 3e10 cells on 3e4 mm^2
+    let e = export::dots_on_face(&fine, &face).unwrap_err().to_string();
+    assert!(
+        e.contains("3.00e10 dot cells") && e.contains("pitch_mm"),
+        "{e}"
+    );
+    // At the cap's own scale it still exports (0.1 mm pitch: 3e6 cells on this face).
+    fine.pitch = 0.1;
+    fine.density = Density::Polynomial(vec![0.0]);
+    assert!(export::dots_on_face(&fine, &face).unwrap().is_empty());
+}
+
+#[test]
 fn random_placements_are_deterministic_and_seeded() {
     let face = [[
         DVec3::new(0.0, 0.0, 0.0),

@@ -95,6 +95,11 @@ impl SheetFrame {
     }
 }
 
+/// Most dots an export writes: a 300 x 200 mm face at 0.05 mm pitch (finer than screen
+/// printing resolves) is 2.4e7 cells; beyond this a pitch is a simulation choice, not a
+/// printable sheet, and the files would run to gigabytes.
+pub const MAX_EXPORTED_DOTS: usize = 30_000_000;
+
 /// Every dot whose centre lies on the face made of `triangles` (scene coordinates, the
 /// same frame as `pattern.origin`), placed as the pattern's `placement` says, in row
 /// order. Dots of zero diameter are left out. A `virtual` pattern prints no dots: that is
@@ -104,6 +109,19 @@ pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Result<Ve
         bail!(
             "placement \"virtual\" is not printable (each hit meets ink with probability d; there are no dots to print): \
              export a printable placement of the same density instead (\"lattice\", \"jittered\" or \"stochastic\")"
+        );
+    }
+    let area: f64 = triangles
+        .iter()
+        .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length())
+        .sum();
+    let cells = area / pattern.lattice.cell_area(pattern.pitch);
+    if !(cells <= MAX_EXPORTED_DOTS as f64) {
+        bail!(
+            "the face ({area:.0} mm^2) holds about {cells:.2e} dot cells at pitch {} mm: \
+             exports stop at {MAX_EXPORTED_DOTS:.0e} dots (about 1 GB of CSV); \
+             choose a coarser pitch_mm for a printable sheet",
+            pattern.pitch
         );
     }
     let mut seen = HashSet::new();

@@ -116,7 +116,7 @@ pub fn dots_on_face(pattern: &DotPattern, triangles: &[[DVec3; 3]]) -> Result<Ve
         .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length())
         .sum();
     let cells = area / pattern.lattice.cell_area(pattern.pitch);
-    if !(cells <= MAX_EXPORTED_DOTS as f64) {
+    if cells.is_nan() || cells > MAX_EXPORTED_DOTS as f64 {
         bail!(
             "the face ({area:.0} mm^2) holds about {cells:.2e} dot cells at pitch {} mm: \
              exports stop at {MAX_EXPORTED_DOTS:.0e} dots (about 1 GB of CSV); \

@@ -1,11 +1,10 @@
 //! What each geometry file put into the scene, for `blutrace check`: triangles and
 //! bounding boxes in millimetres after all transforms, per file and per tag, and the
 //! placement warnings that catch unit and axis mistakes (a part 1000x too large or small,
-//! a lamp or the detector plane cutting through a part).
+//! the detector plane cutting through a part; lamps cutting parts: [`super::lamp_placement`]).
 
 use crate::detector::TargetPlane;
 use crate::geometry::Mesh;
-use crate::sources::{Emitter, Source};
 use glam::DVec3;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -147,96 +146,18 @@ pub fn detector_cuts(
         .collect()
 }
 
-/// Warnings where a mesh vertex lies inside a CCFL tube, or a triangle crosses an LED's
-/// emitting rectangle: light would be emitted inside a part.
-pub fn source_cuts(
-    mesh: &Mesh,
-    tags: &[String],
-    sources: &[Source],
-    eps: f64,
-    offset: DVec3,
-) -> Vec<String> {
-    let mut out = Vec::new();
-    for s in sources {
-        let grid = s.emitter.surface_grid(24);
-        let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
-        for (p, &tag) in mesh.tri_tag.iter().enumerate() {
-            let c = mesh.corners(p as u32);
-            if hit.contains_key(&tag) {
-                continue;
-            }
-            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {
-                hit.insert(tag, c[0] + offset);
-            }
-        }
-        out.extend(hit.into_iter().map(|(tag, at)| {
-            format!(
-                "source '{}': its emitting surface cuts tag '{}' (near {at:.3?} mm)",
-                s.name, tags[tag as usize]
-            )
-        }));
-    }
-    out
-}
-
-/// True when points of the emitting surface's `grid` lie more than `eps` on both sides of
-/// triangle `prim`, with their feet inside it: the triangle passes through the surface
-/// (a sheet through a tube, whose vertices all lie outside it).
-fn crosses_grid(mesh: &Mesh, prim: u32, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
-    let c = mesh.corners(prim);
-    let n = mesh.area_normal(prim).normalize_or_zero();
-    let (mut above, mut below) = (false, false);
-    for &(g, _) in grid {
-        let h = n.dot(g - c[0]);
-        if h.abs() > eps && mesh.contains(prim, g - n * h) {
-            above |= h > 0.0;
-            below |= h < 0.0;
-            if above && below {
-                return true;
-            }
-        }
-    }
-    false
-}
-
-fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
-    match e {
-        Emitter::Ccfl {
-            center,
-            axis,
-            radius,
-            length,
-        } => c.iter().any(|x| {
-            let rel = *x - *center;
-            let along = rel.dot(*axis);
-            along.abs() < length / 2.0 - eps && (rel - *axis * along).length() < radius - eps
-        }),
-        Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
-            let r = e.rect().expect("an LED has a rectangle");
-            let plane = Plane {
-                origin: r.center,
-                u: r.u,
-                v: r.normal.cross(r.u),
-                n: r.normal,
-            };
-            let half = [r.half_width, r.half_height];
-            plane.cut_meets(c, half.map(|h| -h), half, eps)
-        }
-    }
-}
-
 /// A plane with an in-plane frame: points `origin + a u + b v`, normal `n`.
-struct Plane {
-    origin: DVec3,
-    u: DVec3,
-    v: DVec3,
-    n: DVec3,
+pub(super) struct Plane {
+    pub(super) origin: DVec3,
+    pub(super) u: DVec3,
+    pub(super) v: DVec3,
+    pub(super) n: DVec3,
 }
 
 impl Plane {
     /// True when triangle `c` passes through the plane (vertices more than `eps` on both
     /// sides) along a segment that meets the rectangle `lo..hi` of frame coordinates.
-    fn cut_meets(&self, c: [DVec3; 3], lo: [f64; 2], hi: [f64; 2], eps: f64) -> bool {
+    pub(super) fn cut_meets(&self, c: [DVec3; 3], lo: [f64; 2], hi: [f64; 2], eps: f64) -> bool {
         let s = c.map(|x| self.n.dot(x - self.origin));
         if s.iter().all(|&h| h > -eps) || s.iter().all(|&h| h < eps) {
             return false;

@@ -1,6 +1,6 @@
 //! Where each lamp sits relative to the geometry: in which medium its emitting surface
-//! lies, and which parts come so close to that surface that emitted photons would start
-//! beyond them.
+//! lies, which parts come so close to that surface that emitted photons would start
+//! beyond them, and which parts cut through it (light would be emitted inside a part).
 //!
 //! ```toml
 //! [[sources]]
@@ -14,10 +14,11 @@
 //! medium: otherwise its photons would be traced with the wrong refractive index and
 //! absorption until their first surface, without a word.
 
+use super::geometry_report::Plane;
 use super::solids;
 use crate::geometry::Mesh;
 use crate::optics::medium::{Interface, Medium};
-use crate::sources::Source;
+use crate::sources::{Emitter, Source};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -139,12 +140,97 @@ fn touches(
             }
         }
     }
+    over_triangle(mesh, prim, grid)
+        .find(|&(_, h)| h.abs() <= reach)
+        .map(|(g, _)| g)
+}
+
+/// The points of an emitting surface's `grid` whose foot on the plane of triangle `prim`
+/// lies inside it, each with its signed height above that plane: what both the contact
+/// and the "cuts" warnings look at.
+fn over_triangle<'a>(
+    mesh: &'a Mesh,
+    prim: u32,
+    grid: &'a [(DVec3, DVec3)],
+) -> impl Iterator<Item = (DVec3, f64)> + 'a {
+    let c0 = mesh.corners(prim)[0];
     let n = mesh.area_normal(prim).normalize_or_zero();
-    grid.iter().find_map(|&(g, _)| {
-        let h = n.dot(g - c[0]);
-        let foot = g - n * h;
-        (h.abs() <= reach && mesh.contains(prim, foot)).then_some(g)
+    grid.iter().filter_map(move |&(g, _)| {
+        let h = n.dot(g - c0);
+        mesh.contains(prim, g - n * h).then_some((g, h))
     })
+}
+
+/// Warnings where a mesh vertex lies inside a CCFL tube, or a triangle crosses an LED's
+/// emitting rectangle: light would be emitted inside a part.
+pub(super) fn source_cuts(
+    mesh: &Mesh,
+    tags: &[String],
+    sources: &[Source],
+    eps: f64,
+    offset: DVec3,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in sources {
+        let grid = s.emitter.surface_grid(24);
+        let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
+        for (p, &tag) in mesh.tri_tag.iter().enumerate() {
+            let c = mesh.corners(p as u32);
+            if hit.contains_key(&tag) {
+                continue;
+            }
+            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {
+                hit.insert(tag, c[0] + offset);
+            }
+        }
+        out.extend(hit.into_iter().map(|(tag, at)| {
+            format!(
+                "source '{}': its emitting surface cuts tag '{}' (near {at:.3?} mm)",
+                s.name, tags[tag as usize]
+            )
+        }));
+    }
+    out
+}
+
+/// True when points of the emitting surface's `grid` lie more than `eps` on both sides of
+/// triangle `prim`, with their feet inside it: the triangle passes through the surface
+/// (a sheet through a tube, whose vertices all lie outside it).
+fn crosses_grid(mesh: &Mesh, prim: u32, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
+    let (mut above, mut below) = (false, false);
+    over_triangle(mesh, prim, grid)
+        .filter(|&(_, h)| h.abs() > eps)
+        .any(|(_, h)| {
+            above |= h > 0.0;
+            below |= h < 0.0;
+            above && below
+        })
+}
+
+fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
+    match e {
+        Emitter::Ccfl {
+            center,
+            axis,
+            radius,
+            length,
+        } => c.iter().any(|x| {
+            let rel = *x - *center;
+            let along = rel.dot(*axis);
+            along.abs() < length / 2.0 - eps && (rel - *axis * along).length() < radius - eps
+        }),
+        Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
+            let r = e.rect().expect("an LED has a rectangle");
+            let plane = Plane {
+                origin: r.center,
+                u: r.u,
+                v: r.normal.cross(r.u),
+                n: r.normal,
+            };
+            let half = [r.half_width, r.half_height];
+            plane.cut_meets(c, half.map(|h| -h), half, eps)
+        }
+    }
 }
 
 fn bounds(points: impl Iterator<Item = DVec3>, pad: f64) -> (DVec3, DVec3) {

@@ -258,7 +258,7 @@ impl Scene {
 fn placement_warnings(scene: &Scene) -> Vec<String> {
     let (mesh, tags, eps) = (&scene.mesh, &scene.tags, scene.spawn_eps);
     let mut w = geometry_report::detector_cuts(mesh, tags, &scene.detector, eps, scene.offset);
-    w.extend(geometry_report::source_cuts(
+    w.extend(lamp_placement::source_cuts(
         mesh,
         tags,
         &scene.sources.list,

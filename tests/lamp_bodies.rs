@@ -10,6 +10,11 @@
 //!   takes R of the power and the mirror 1 - R. With a Lambertian body of albedo a (whose
 //!   reflections leave outward, as emission does), the body takes R (1 - a) / (1 - a R) and
 //!   the mirror (1 - R) / (1 - a R).
+//! - An LED (a one-sided Lambertian rectangle w x h with an absorbing body) facing a
+//!   perfect plane mirror at distance d: a reflected photon travels as if from the LED's
+//!   mirror image at distance 2 d, so the fraction that comes back onto the LED's front is
+//!   the view factor between two directly opposed w x h rectangles 2 d apart (Hottel's
+//!   closed form, Howell's catalogue C-11); the rest passes beside the LED and escapes.
 //! - A meshed absorbing tube around a transparent-bodied CCFL converges with the facet
 //!   count to the analytic absorbing body (the emission's spawn offset keeps photons off a
 //!   finely faceted mesh inscribed in the emitting surface).
@@ -213,6 +218,58 @@ fn weighted_and_analog_agree_on_a_reflecting_body() {
         (pa - pw).abs() <= 4.0 * sa * 2f64.sqrt(),
         "analog {pa:.4} vs weighted {pw:.4}"
     );
+}
+
+/// View factor between two directly opposed, parallel `a x b` rectangles `c` apart
+/// (Hottel; Howell, "A Catalog of Radiation Heat Transfer Configuration Factors", C-11).
+fn opposed_rectangles(a: f64, b: f64, c: f64) -> f64 {
+    let (x, y) = (a / c, b / c);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    2.0 / (std::f64::consts::PI * x * y)
+        * ((((1.0 + x * x) * (1.0 + y * y)) / (1.0 + x * x + y * y))
+            .sqrt()
+            .ln()
+            + x * sy * (x / sy).atan()
+            + y * sx * (y / sx).atan()
+            - x * x.atan()
+            - y * y.atan())
+}
+
+#[test]
+fn an_led_facing_a_mirror_gets_back_the_view_factor_of_its_image() {
+    // Two unit squares 1 apart: 0.19982 (the catalogue's value), a check of the formula.
+    assert!((opposed_rectangles(1.0, 1.0, 1.0) - 0.19982).abs() < 1e-5);
+    // A 2 x 1 mm LED at z = 0 facing +z, a 2 m square mirror of reflectance 1 at
+    // z = 0.5 mm; photons past the mirror's edge (grazing within 0.06 degrees: a
+    // fraction below 1e-6 of a Lambertian emission) are negligible.
+    let (w, h, d) = (2.0, 1.0, 0.5);
+    let mirror = "v -1000 -1000 0.5\nv 1000 -1000 0.5\nv 1000 1000 0.5\nv -1000 1000 0.5\n\
+                  usemtl mirror\nf 1 2 3\nf 1 3 4\n";
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"mirror.obj\"\n\
+         [surfaces.mirror]\nmodel = \"mirror\"\nreflectance = 1.0\n\
+         [[sources]]\ntype = \"led\"\nname = \"led\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = {w}\nheight_mm = {h}\npower_w = 1.0\nbody = \"absorber\"\n\
+         [detector]\norigin = [3000.0, 3000.0, 3000.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [1.0, 1.0]\nbins = [1, 1]\n"
+    );
+    let scene = load(&write_scene("led-mirror", &toml, &[("mirror.obj", mirror)]));
+    let n = 200_000;
+    for backend in [BackendChoice::Bvh, BackendChoice::Auto] {
+        let r = trace_opts(&scene, &analog(n, backend));
+        assert_balanced(&r);
+        let (back, se) = fraction(r.tally.ledger.absorbed_by_source[0].value(), n);
+        let expected = opposed_rectangles(w, h, 2.0 * d);
+        assert!(
+            (back - expected).abs() < 4.0 * se,
+            "{backend:?}: {back} +- {se} returned to the LED, view factor {expected}"
+        );
+        let (escaped, _) = fraction(r.tally.ledger.escaped.value(), n);
+        assert!(
+            (back + escaped - 1.0).abs() < 1e-12,
+            "nothing else: {escaped}"
+        );
+    }
 }
 
 #[test]

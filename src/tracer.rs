@@ -254,9 +254,10 @@ impl Tracer<'_> {
             return Flight::Reached;
         }
         match self.estimator {
-            // An escaping photon (t infinite) leaves the scene: nothing more is absorbed
-            // here, under either estimator.
-            Estimator::Analog if t.is_infinite() => Flight::Reached,
+            // A photon leaving the scene inside an absorbing medium (t infinite: the
+            // black surround the physics and stability tests use to catch leaks) is
+            // absorbed there; the weighted estimator books it escaped at its weight
+            // instead (noted on issue 18: the two should agree).
             Estimator::Analog => {
                 // Absorption is memoryless: one exponential depth per photon, spent
                 // segment by segment (a t each), has the law of a fresh free path per

@@ -5,9 +5,10 @@ mod support;
 
 use blutrace::accel::BackendChoice;
 use blutrace::optics::surface::Estimator;
-use blutrace::run::metrics::Metric;
+use blutrace::run::metrics::{Metric, MetricValues, Metrics, flux_map, leave_one_out, with_errors};
 use blutrace::run::{RunOptions, StoppedBy, TargetMetric};
 use blutrace::scene::Scene;
+use blutrace::tally::{Sign, Tally};
 use support::*;
 
 fn opts(photons: u64, seed: u64) -> RunOptions {
@@ -212,4 +213,201 @@ fn weighted_runs_are_thread_independent_too() {
     );
     assert_eq!(one.tally, two.tally);
     assert_eq!(one.groups, two.groups);
+}
+
+/// Every metric of a tally as first written (plain sums over a full flux map, one metric
+/// at a time): the reference for the metrics' bits.
+fn metrics_the_plain_way(scene: &Scene, t: &Tally) -> MetricValues {
+    let m = flux_map(scene, t);
+    let v = &m.value;
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+    let min_over_max = |values: &mut dyn Iterator<Item = f64>| {
+        let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+        if hi > 0.0 { lo / hi } else { f64::NAN }
+    };
+    let spot_mean = |fx: f64, fy: f64| {
+        let cx = ((fx * m.nx as f64) as usize).min(m.nx - 1);
+        let cy = ((fy * m.ny as f64) as usize).min(m.ny - 1);
+        let (mut sum, mut k) = (0.0, 0);
+        for y in cy.saturating_sub(1)..=(cy + 1).min(m.ny - 1) {
+            for x in cx.saturating_sub(1)..=(cx + 1).min(m.nx - 1) {
+                sum += v[y * m.nx + x];
+                k += 1;
+            }
+        }
+        sum / k as f64
+    };
+    let nine = [1.0 / 6.0, 0.5, 5.0 / 6.0];
+    let mut points: Vec<(f64, f64)> = nine
+        .iter()
+        .flat_map(|&y| nine.iter().map(move |&x| (x, y)))
+        .collect();
+    let nine_point = min_over_max(&mut points.iter().map(|&(x, y)| spot_mean(x, y)));
+    points.extend([(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]);
+    let thirteen_point = min_over_max(&mut points.iter().map(|&(x, y)| spot_mean(x, y)));
+    let cv = if mean > 0.0 {
+        var.sqrt() / mean
+    } else {
+        f64::NAN
+    };
+    let floor = (m.stderr.iter().map(|s| s * s).sum::<f64>() / m.stderr.len() as f64).sqrt() / mean;
+    let rel: Vec<f64> = v
+        .iter()
+        .zip(&m.stderr)
+        .filter(|(v, _)| **v > 0.0)
+        .map(|(v, s)| s / v)
+        .collect();
+    MetricValues::from_fn(|metric| match metric {
+        Metric::Mean => mean,
+        Metric::Efficiency => t.ledger.detected.mean_and_stderr(t.ledger.photons).0,
+        Metric::Cv => cv,
+        Metric::CvDebiased => (cv * cv - floor * floor).max(0.0).sqrt(),
+        Metric::MinOverMax => min_over_max(&mut v.iter().copied()),
+        Metric::NinePoint => nine_point,
+        Metric::ThirteenPoint => thirteen_point,
+        Metric::MeanRelStderr if rel.is_empty() => f64::NAN,
+        Metric::MeanRelStderr => rel.iter().sum::<f64>() / rel.len() as f64,
+    })
+}
+
+/// The jackknife as first written, the reference the fast path must equal bit for bit:
+/// the total rebuilt from the groups, every leave-one-out tally a whole copy of it with
+/// the group taken out, and its metrics from a full flux map.
+fn leave_one_out_by_rebuilding(scene: &Scene, groups: &[Tally]) -> Vec<MetricValues> {
+    let used: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
+    let mut total = Tally::new(scene);
+    used.iter().for_each(|g| total.merge(g));
+    used.iter()
+        .map(|g| {
+            let mut t = total.clone();
+            t.merge_signed(g, Sign::Remove);
+            let plain = metrics_the_plain_way(scene, &t);
+            assert_eq!(bits(&Metrics::of(scene, &t).values()), bits(&plain));
+            plain
+        })
+        .collect()
+}
+
+/// `with_errors` as first written, on [`leave_one_out_by_rebuilding`].
+fn with_errors_by_rebuilding(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+) -> (MetricValues, MetricValues) {
+    let values = metrics_the_plain_way(scene, total);
+    assert_eq!(bits(&Metrics::of(scene, total).values()), bits(&values));
+    let leave_out = leave_one_out_by_rebuilding(scene, groups);
+    let mut stderr = MetricValues::from_fn(|m| {
+        let k = leave_out.len() as f64;
+        if leave_out.len() < 2 {
+            return f64::NAN;
+        }
+        let mean = leave_out.iter().map(|v| v[m]).sum::<f64>() / k;
+        let ss: f64 = leave_out.iter().map(|v| (v[m] - mean).powi(2)).sum();
+        ((k - 1.0) / k * ss).sqrt()
+    });
+    stderr[Metric::MeanRelStderr] = 0.0;
+    let l = &total.ledger;
+    stderr[Metric::Efficiency] = l.detected.mean_and_stderr(l.photons).1;
+    (values, stderr)
+}
+
+fn bits(v: &MetricValues) -> Vec<u64> {
+    v.iter().map(|(_, x)| x.to_bits()).collect()
+}
+
+/// The run's history row, `with_errors` and `leave_one_out` (outside any rayon pool and
+/// inside one) all equal the reference bit for bit.
+fn assert_jackknife_is_the_reference(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+    row: Option<(MetricValues, MetricValues)>,
+) {
+    let (values, stderr) = with_errors_by_rebuilding(scene, total, groups);
+    let reference = leave_one_out_by_rebuilding(scene, groups);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let computed = [
+        (
+            with_errors(scene, total, groups),
+            leave_one_out(scene, total, groups),
+        ),
+        pool.install(|| {
+            (
+                with_errors(scene, total, groups),
+                leave_one_out(scene, total, groups),
+            )
+        }),
+    ];
+    for ((v, e), leave_out) in computed
+        .into_iter()
+        .chain(row.map(|r| (r, reference.clone())))
+    {
+        assert_eq!(bits(&v), bits(&values), "values {v:?} against {values:?}");
+        assert_eq!(bits(&e), bits(&stderr), "errors {e:?} against {stderr:?}");
+        assert_eq!(leave_out.len(), reference.len());
+        for (a, b) in leave_out.iter().zip(&reference) {
+            assert_eq!(bits(a), bits(b), "leave-one-out {a:?} against {b:?}");
+        }
+    }
+}
+
+/// The jackknife takes each group out of the total's map bin by bin, only where the group
+/// scored, runs the leave-outs in parallel and sums each map in one pass: its results
+/// must be those of rebuilding every map whole and summing it metric by metric. Traced runs (analog and weighted, a partial last chunk, so leave-outs
+/// over different photon counts), and hand-made groups with weights over 15 decades, an
+/// empty group, zero weights and a single-group tally.
+#[test]
+fn jackknife_equals_rebuilding_every_map_bit_for_bit() {
+    let scene = plate_scene("jackknife-bits");
+    for (photons, estimator) in [(150_000, Estimator::Analog), (50_000, Estimator::Weighted)] {
+        let r = trace_opts(
+            &scene,
+            &RunOptions {
+                estimator,
+                ..opts(photons, 9)
+            },
+        );
+        let row = r.final_row().map(|row| (row.values, row.stderr));
+        assert_jackknife_is_the_reference(&scene, &r.tally, &r.groups, row);
+    }
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    let mut groups = vec![Tally::new(&scene); 32];
+    let (nx, ny) = (groups[0].flux.nx, groups[0].flux.ny);
+    for (gi, g) in groups.iter_mut().enumerate() {
+        if gi == 5 {
+            continue; // an empty group
+        }
+        g.ledger.photons = 1000 + (gi as u64 % 3) * 17;
+        for _ in 0..(next() % 60) {
+            let w = match next() % 4 {
+                0 => 0.0,
+                1 => 1.0,
+                _ => 10f64.powf((next() % 1500) as f64 / 100.0 - 12.0),
+            };
+            let (ix, iy) = ((next() % nx as u64) as usize, (next() % ny as u64) as usize);
+            g.flux.add(ix, iy, w);
+            g.ledger.detected.add(w);
+        }
+    }
+    let mut total = Tally::new(&scene);
+    groups.iter().for_each(|g| total.merge(g));
+    assert_jackknife_is_the_reference(&scene, &total, &groups, None);
+    let mut single = vec![Tally::new(&scene); 32];
+    single[3] = groups[0].clone();
+    assert_jackknife_is_the_reference(&scene, &groups[0], &single, None);
 }

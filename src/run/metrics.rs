@@ -10,8 +10,14 @@
 //! noise floor, the cv a perfectly uniform source would show at this photon count
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
 
+mod jackknife;
+
+pub use jackknife::{
+    ScoredBins, jackknife, jackknife_stderr, leave_one_out, with_errors, with_errors_scored,
+};
+
 use crate::scene::Scene;
-use crate::tally::{Grid, Sign, Tally};
+use crate::tally::{BinStats, Grid, Tally};
 use serde::Serialize;
 
 /// Number of interleaved photon groups kept for jackknife errors.
@@ -109,13 +115,20 @@ fn grid_map(scene: &Scene, t: &Tally, g: &Grid, measure: impl Fn(usize) -> f64) 
         hits: Vec::new(),
     };
     for (i, b) in g.bins.iter().enumerate() {
-        let (mean, se) = b.mean_and_stderr(n);
-        let k = total / measure(i);
-        m.value.push(mean * k);
-        m.stderr.push(se * k);
+        let (value, stderr) = bin_value(b, n, total / measure(i));
+        m.value.push(value);
+        m.stderr.push(stderr);
         m.hits.push(b.hits);
     }
     m
+}
+
+/// A bin's value and standard error over `n` photons, times `k` (watts per unit photon
+/// weight, over the bin's measure). Every map and every leave-one-out map reads its bins
+/// through this one function, so equal sums give equal bits.
+fn bin_value(b: &BinStats, n: u64, k: f64) -> (f64, f64) {
+    let (mean, se) = b.mean_and_stderr(n);
+    (mean * k, se * k)
 }
 
 /// Uniformity metrics of a flux map.
@@ -136,16 +149,22 @@ pub struct Uniformity {
 impl Uniformity {
     /// Metrics of `m`'s values.
     pub fn of(m: &Map) -> Self {
-        let v = &m.value;
+        Self::of_values(m.nx, m.ny, &m.value, &MapSums::of(&m.value, &m.stderr))
+    }
+
+    /// Metrics of the values `v` of an `nx` x `ny` map (row-major, x fastest) whose sums
+    /// are `sums`.
+    fn of_values(nx: usize, ny: usize, v: &[f64], sums: &MapSums) -> Self {
         let n = v.len() as f64;
-        let mean = v.iter().sum::<f64>() / n;
+        let mean = sums.value / n;
         let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
         let nine = [1.0 / 6.0, 0.5, 5.0 / 6.0];
         let mut points: Vec<(f64, f64)> = nine
             .iter()
             .flat_map(|&y| nine.iter().map(move |&x| (x, y)))
             .collect();
-        let spot = |pts: &[(f64, f64)]| min_over_max(pts.iter().map(|&(x, y)| spot_mean(m, x, y)));
+        let spot =
+            |pts: &[(f64, f64)]| min_over_max(pts.iter().map(|&(x, y)| spot_mean(nx, ny, v, x, y)));
         let nine_point = spot(&points);
         points.extend([(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]);
         Uniformity {
@@ -155,10 +174,49 @@ impl Uniformity {
             } else {
                 f64::NAN
             },
-            min_over_max: min_over_max(v.iter().copied()),
+            min_over_max: ratio(sums.lo, sums.hi),
             nine_point_min_over_max: nine_point,
             thirteen_point_min_over_max: spot(&points),
         }
+    }
+}
+
+/// The sums and extremes over a map that the metrics read, taken in one pass over the
+/// bins (the metrics of every leave-one-out map read them). Each sum runs in bin order
+/// from -0.0, as `Iterator::sum` does, so each equals its plain expression bit for bit.
+struct MapSums {
+    /// Sum of the values.
+    value: f64,
+    /// Sum of the squared standard errors.
+    stderr_sq: f64,
+    /// Smallest and largest value (from +inf and 0).
+    lo: f64,
+    hi: f64,
+    /// Sum of stderr / value over the lit bins (value > 0), and their number.
+    rel: f64,
+    lit: usize,
+}
+
+impl MapSums {
+    fn of(value: &[f64], stderr: &[f64]) -> Self {
+        let mut s = MapSums {
+            value: -0.0,
+            stderr_sq: -0.0,
+            lo: f64::INFINITY,
+            hi: 0.0,
+            rel: -0.0,
+            lit: 0,
+        };
+        for (&v, &e) in value.iter().zip(stderr) {
+            s.value += v;
+            s.stderr_sq += e * e;
+            (s.lo, s.hi) = (s.lo.min(v), s.hi.max(v));
+            if v > 0.0 {
+                s.rel += e / v;
+                s.lit += 1;
+            }
+        }
+        s
     }
 }
 
@@ -166,17 +224,22 @@ fn min_over_max(values: impl Iterator<Item = f64>) -> f64 {
     let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
         (lo.min(x), hi.max(x))
     });
+    ratio(lo, hi)
+}
+
+/// Smallest over largest (NaN when nothing is lit).
+fn ratio(lo: f64, hi: f64) -> f64 {
     if hi > 0.0 { lo / hi } else { f64::NAN }
 }
 
-/// Mean of the 3x3 bins around the fractional position (fx, fy) of the map.
-fn spot_mean(m: &Map, fx: f64, fy: f64) -> f64 {
-    let cx = ((fx * m.nx as f64) as usize).min(m.nx - 1);
-    let cy = ((fy * m.ny as f64) as usize).min(m.ny - 1);
+/// Mean of the 3x3 bins around the fractional position (fx, fy) of an `nx` x `ny` map.
+fn spot_mean(nx: usize, ny: usize, v: &[f64], fx: f64, fy: f64) -> f64 {
+    let cx = ((fx * nx as f64) as usize).min(nx - 1);
+    let cy = ((fy * ny as f64) as usize).min(ny - 1);
     let (mut sum, mut n) = (0.0, 0);
-    for y in cy.saturating_sub(1)..=(cy + 1).min(m.ny - 1) {
-        for x in cx.saturating_sub(1)..=(cx + 1).min(m.nx - 1) {
-            sum += m.value[y * m.nx + x];
+    for y in cy.saturating_sub(1)..=(cy + 1).min(ny - 1) {
+        for x in cx.saturating_sub(1)..=(cx + 1).min(nx - 1) {
+            sum += v[y * nx + x];
             n += 1;
         }
     }
@@ -202,26 +265,24 @@ impl Metrics {
     /// Point estimates from a tally.
     pub fn of(scene: &Scene, t: &Tally) -> Self {
         let m = flux_map(scene, t);
-        let u = Uniformity::of(&m);
-        let floor =
-            (m.stderr.iter().map(|s| s * s).sum::<f64>() / m.stderr.len() as f64).sqrt() / u.mean;
         let (eff, _) = t.ledger.detected.mean_and_stderr(t.ledger.photons);
-        let rel: Vec<f64> = m
-            .value
-            .iter()
-            .zip(&m.stderr)
-            .filter(|(v, _)| **v > 0.0)
-            .map(|(v, s)| s / v)
-            .collect();
+        Self::of_flux(m.nx, m.ny, &m.value, &m.stderr, eff)
+    }
+
+    /// Point estimates from a flux map's values and errors and the efficiency.
+    fn of_flux(nx: usize, ny: usize, value: &[f64], stderr: &[f64], eff: f64) -> Self {
+        let sums = MapSums::of(value, stderr);
+        let u = Uniformity::of_values(nx, ny, value, &sums);
+        let floor = (sums.stderr_sq / stderr.len() as f64).sqrt() / u.mean;
         Metrics {
             uniformity: u,
             extraction_efficiency: eff,
             cv_noise_floor: floor,
             cv_debiased: (u.cv * u.cv - floor * floor).max(0.0).sqrt(),
-            mean_rel_stderr: if rel.is_empty() {
+            mean_rel_stderr: if sums.lit == 0 {
                 f64::NAN
             } else {
-                rel.iter().sum::<f64>() / rel.len() as f64
+                sums.rel / sums.lit as f64
             },
         }
     }
@@ -337,49 +398,11 @@ pub fn median(mut values: Vec<f64>) -> f64 {
     }
 }
 
-/// Jackknife standard errors of every metric from the per-group tallies.
-/// Returns NaN errors when fewer than two groups hold photons.
-pub fn jackknife(scene: &Scene, groups: &[Tally]) -> MetricValues {
-    let leave_out = leave_one_out(scene, groups);
-    MetricValues::from_fn(|m| jackknife_stderr(&leave_out.iter().map(|v| v[m]).collect::<Vec<_>>()))
-}
-
-/// Every metric of the run with each group left out in turn (the groups holding photons).
-pub fn leave_one_out(scene: &Scene, groups: &[Tally]) -> Vec<MetricValues> {
-    let used: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
-    let mut total = Tally::new(scene);
-    used.iter().for_each(|g| total.merge(g));
-    // Leaving a group out = taking it out of the total: exact, as the sums are integers.
-    used.iter()
-        .map(|g| {
-            let mut t = total.clone();
-            t.merge_signed(g, Sign::Remove);
-            Metrics::of(scene, &t).values()
-        })
-        .collect()
-}
-
-/// The jackknife standard error `sqrt((k - 1) / k sum (x_i - mean)^2)` of a statistic
-/// from its `k` leave-one-out values (NaN for fewer than two).
-pub fn jackknife_stderr(leave_out: &[f64]) -> f64 {
-    let k = leave_out.len();
-    if k < 2 {
-        return f64::NAN;
-    }
-    let mean = leave_out.iter().sum::<f64>() / k as f64;
-    let ss: f64 = leave_out.iter().map(|v| (v - mean).powi(2)).sum();
-    ((k - 1) as f64 / k as f64 * ss).sqrt()
-}
-
-/// Every metric of the tally `total` and its standard error (jackknife over `groups`,
-/// the same photons split by chunk); the per-bin metric, itself an error, gets none. The
-/// efficiency, a mean over photons, gets its exact per-photon error, the one the summary
-/// reports, so the convergence history and the summary agree.
-pub fn with_errors(scene: &Scene, total: &Tally, groups: &[Tally]) -> (MetricValues, MetricValues) {
-    let values = Metrics::of(scene, total).values();
-    let mut stderr = jackknife(scene, groups);
-    stderr[Metric::MeanRelStderr] = 0.0;
-    let l = &total.ledger;
-    stderr[Metric::Efficiency] = l.detected.mean_and_stderr(l.photons).1;
-    (values, stderr)
+/// A flux map's values and errors, without hit counts: what the scalar metrics read.
+#[derive(Clone, Default)]
+struct FluxValues {
+    nx: usize,
+    ny: usize,
+    value: Vec<f64>,
+    stderr: Vec<f64>,
 }

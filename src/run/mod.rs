@@ -30,10 +30,10 @@ use crate::output::{
     atomic::{OutputSet, SetDir},
 };
 use crate::scene::Scene;
-use crate::tally::Tally;
+use crate::tally::{ChunkTally, Tally};
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
-use metrics::{GROUPS, Map, Metric, MetricValues};
+use metrics::{GROUPS, Map, Metric, MetricValues, ScoredBins};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -285,12 +285,12 @@ pub fn trace<'a>(
         let end = state.next_round_end(options, start.elapsed().as_secs_f64());
         pool.install(|| {
             tracer.run_range(options.seed, state.traced, end, progress, &mut |c| {
-                state.groups[(c.index % GROUPS as u64) as usize].absorb(c);
-                state.total.absorb(c);
+                state.absorb(c)
             })
         });
         state.traced = end;
-        state.record(scene, start.elapsed().as_secs_f64());
+        let seconds = start.elapsed().as_secs_f64();
+        pool.install(|| state.record(scene, seconds));
     };
     Ok(RunResult {
         scene,
@@ -315,6 +315,8 @@ struct Rounds {
     traced: u64,
     total: Tally,
     groups: Vec<Tally>,
+    /// The flux bins each group has scored in (for the jackknife).
+    scored: ScoredBins,
     history: Vec<ConvergenceRow>,
 }
 
@@ -326,8 +328,19 @@ impl Rounds {
             traced: first,
             total: Tally::new(scene),
             groups: vec![Tally::new(scene); GROUPS],
+            scored: ScoredBins::new(GROUPS, scene.detector.bins[0] * scene.detector.bins[1]),
             history: Vec::new(),
         }
+    }
+
+    /// Add a traced chunk to its group and to the total.
+    fn absorb(&mut self, c: &ChunkTally) {
+        let g = (c.index % GROUPS as u64) as usize;
+        self.groups[g].absorb(c);
+        c.detections
+            .iter()
+            .for_each(|d| self.scored.mark(g, d.flux_bin));
+        self.total.absorb(c);
     }
 
     fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
@@ -361,7 +374,8 @@ impl Rounds {
     }
 
     fn record(&mut self, scene: &Scene, seconds: f64) {
-        let (values, stderr) = metrics::with_errors(scene, &self.total, &self.groups);
+        let (values, stderr) =
+            metrics::with_errors_scored(scene, &self.total, &self.groups, &self.scored);
         self.history.push(ConvergenceRow {
             photons: self.traced,
             seconds,

@@ -127,7 +127,7 @@ impl ObjectiveSpec {
     pub fn evaluate(&self, run: &RunResult) -> LayoutEvaluation {
         let metrics = Metrics::of(run.scene, &run.tally);
         let values = metrics.values();
-        let leave_out = leave_one_out(run.scene, &run.groups);
+        let leave_out = leave_one_out(run.scene, &run.tally, &run.groups);
         let se = |f: &dyn Fn(&MetricValues) -> f64| {
             jackknife_stderr(&leave_out.iter().map(f).collect::<Vec<_>>())
         };

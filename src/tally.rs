@@ -396,9 +396,15 @@ impl Tally {
 
     /// Add the events of one traced chunk.
     pub fn absorb(&mut self, c: &ChunkTally) {
-        for d in &c.detections {
-            self.flux.bins[d.flux_bin as usize].add(d.weight);
-            self.angular.bins[d.angular_bin as usize].add(d.weight);
+        self.absorb_scored(c, &c.scored());
+    }
+
+    /// Add the events of one traced chunk whose detections are `scored`
+    /// ([`ChunkTally::scored`]).
+    pub fn absorb_scored(&mut self, c: &ChunkTally, scored: &[BinStats]) {
+        for (d, one) in c.detections.iter().zip(scored) {
+            self.flux.bins[d.flux_bin as usize].merge(one);
+            self.angular.bins[d.angular_bin as usize].merge(one);
         }
         self.ledger.merge(&c.ledger);
     }
@@ -425,6 +431,22 @@ pub struct ChunkTally {
     pub detections: Vec<Detection>,
     /// The chunk's ledger.
     pub ledger: Ledger,
+}
+
+impl ChunkTally {
+    /// Each detection scored alone into a bin: rounded to fixed point once, then merged
+    /// into a flux and an angular bin of every tally the chunk goes to (the same integers
+    /// as scoring it in each).
+    pub fn scored(&self) -> Vec<BinStats> {
+        self.detections
+            .iter()
+            .map(|d| {
+                let mut one = BinStats::default();
+                one.add(d.weight);
+                one
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 mod jackknife;
 
 pub use jackknife::{
-    ScoredBins, jackknife, jackknife_stderr, leave_one_out, with_errors, with_errors_scored,
+    BinSet, ScoredBins, jackknife, jackknife_stderr, leave_one_out, with_errors, with_errors_scored,
 };
 
 use crate::scene::Scene;

@@ -30,12 +30,14 @@ use crate::output::{
     atomic::{OutputSet, SetDir},
 };
 use crate::scene::Scene;
-use crate::tally::{ChunkTally, Tally};
+use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
-use metrics::{GROUPS, Map, Metric, MetricValues, ScoredBins};
+use metrics::{BinSet, GROUPS, Map, Metric, MetricValues, ScoredBins};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// The metric a `--target-error` refers to.
@@ -283,12 +285,7 @@ pub fn trace<'a>(
             break why;
         }
         let end = state.next_round_end(options, start.elapsed().as_secs_f64());
-        pool.install(|| {
-            tracer.run_range(options.seed, state.traced, end, progress, &mut |c| {
-                state.absorb(c)
-            })
-        });
-        state.traced = end;
+        pool.install(|| state.trace_round(&tracer, options.seed, end, progress));
         let seconds = start.elapsed().as_secs_f64();
         pool.install(|| state.record(scene, seconds));
     };
@@ -333,14 +330,41 @@ impl Rounds {
         }
     }
 
-    /// Add a traced chunk to its group and to the total.
-    fn absorb(&mut self, c: &ChunkTally) {
-        let g = (c.index % GROUPS as u64) as usize;
-        self.groups[g].absorb(c);
-        c.detections
-            .iter()
-            .for_each(|d| self.scored.mark(g, d.flux_bin));
-        self.total.absorb(c);
+    /// Trace photons `traced..end` on the current rayon pool. Every chunk is scored into
+    /// its group and the total by the worker that traced it, as soon as it is traced,
+    /// under a lock per tally (the group's is rarely contended: consecutive chunks go to
+    /// different groups), so no worker waits for a serial merge. The sums are integers,
+    /// so the order in which chunks arrive does not matter.
+    fn trace_round(
+        &mut self,
+        tracer: &Tracer,
+        seed: u64,
+        end: u64,
+        progress: &(dyn Fn(u64) + Sync),
+    ) {
+        let groups: Vec<Mutex<(&mut Tally, &mut BinSet)>> = self
+            .groups
+            .iter_mut()
+            .zip(self.scored.sets_mut())
+            .map(Mutex::new)
+            .collect();
+        let total = Mutex::new(&mut self.total);
+        (self.traced / CHUNK..end.div_ceil(CHUNK))
+            .into_par_iter()
+            .for_each(|c| {
+                let last = ((c + 1) * CHUNK).min(end);
+                tracer.run_range(seed, c * CHUNK, last, progress, &mut |chunk| {
+                    let scored = chunk.scored();
+                    {
+                        let mut group = lock(&groups[(chunk.index % GROUPS as u64) as usize]);
+                        let (tally, bins) = &mut *group;
+                        tally.absorb_scored(chunk, &scored);
+                        chunk.detections.iter().for_each(|d| bins.mark(d.flux_bin));
+                    }
+                    lock(&total).absorb_scored(chunk, &scored);
+                })
+            });
+        self.traced = end;
     }
 
     fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
@@ -383,6 +407,11 @@ impl Rounds {
             stderr,
         });
     }
+}
+
+/// Lock `m`; a worker that panicked while holding it has already failed the run.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Relative standard error of a metric (the per-bin metric is already relative).

@@ -16,49 +16,50 @@ use crate::tally::{BinStats, Sign, Tally};
 use rayon::prelude::*;
 
 /// For each group, the flux bins it has scored in: the only bins where a map with that
-/// group left out differs from the total's. One bit per flux bin and group.
+/// group left out differs from the total's.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ScoredBins {
-    /// 64-bit words per group.
-    words: usize,
-    /// Group `g`'s bits at `g * words ..`.
-    bits: Vec<u64>,
-}
+pub struct ScoredBins(Vec<BinSet>);
+
+/// A set of flux bins, one bit each.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BinSet(Vec<u64>);
 
 impl ScoredBins {
     /// No bin scored yet, for `groups` groups of `bins` flux bins.
     pub fn new(groups: usize, bins: usize) -> Self {
-        let words = bins.div_ceil(64);
-        Self {
-            words,
-            bits: vec![0; groups * words],
-        }
+        Self(vec![BinSet(vec![0; bins.div_ceil(64)]); groups])
     }
 
     /// The bins each of `groups` holds anything in.
     pub fn of(groups: &[Tally]) -> Self {
         let bins = groups.first().map_or(0, |g| g.flux.bins.len());
         let mut s = Self::new(groups.len(), bins);
-        for (g, t) in groups.iter().enumerate() {
+        for (set, t) in s.0.iter_mut().zip(groups) {
             for (i, b) in t.flux.bins.iter().enumerate() {
                 if *b != BinStats::default() {
-                    s.mark(g, i as u32);
+                    set.mark(i as u32);
                 }
             }
         }
         s
     }
 
-    /// Note that group `g` scored in flux bin `bin`.
-    pub fn mark(&mut self, g: usize, bin: u32) {
+    /// Each group's set.
+    pub fn sets_mut(&mut self) -> &mut [BinSet] {
+        &mut self.0
+    }
+}
+
+impl BinSet {
+    /// Add flux bin `bin`.
+    pub fn mark(&mut self, bin: u32) {
         let bin = bin as usize;
-        self.bits[g * self.words + bin / 64] |= 1 << (bin % 64);
+        self.0[bin / 64] |= 1 << (bin % 64);
     }
 
-    /// The bins group `g` scored in, in increasing order.
-    fn bins(&self, g: usize) -> impl Iterator<Item = usize> + '_ {
-        let words = &self.bits[g * self.words..(g + 1) * self.words];
-        words.iter().enumerate().flat_map(|(w, &word)| {
+    /// The bins in the set, in increasing order.
+    fn iter(&self) -> impl Iterator<Item = usize> + '_ {
+        self.0.iter().enumerate().flat_map(|(w, &word)| {
             let mut rest = word;
             std::iter::from_fn(move || {
                 (rest != 0).then(|| {
@@ -163,7 +164,7 @@ fn leave_one_out_from(
         // in flight (the groups' tallies are far apart in memory), the maths then runs
         // on bins at hand.
         scratch.rest.clear();
-        scratch.rest.extend(scored.bins(index).map(|i| {
+        scratch.rest.extend(scored.0[index].iter().map(|i| {
             let mut rest = total.flux.bins[i];
             rest.merge_signed(&g.flux.bins[i], Sign::Remove);
             (i, rest)

@@ -14,6 +14,7 @@ use super::{FluxValues, Metric, MetricValues, Metrics, bin_value};
 use crate::scene::Scene;
 use crate::tally::{BinStats, Sign, Tally};
 use rayon::prelude::*;
+use std::cell::RefCell;
 
 /// For each group, the flux bins it has scored in: the only bins where a map with that
 /// group left out differs from the total's.
@@ -158,32 +159,42 @@ fn leave_one_out_from(
     used: &[(usize, &Tally)],
     scored: &ScoredBins,
 ) -> Vec<MetricValues> {
-    in_pool(used, Scratch::default, |scratch, &(index, g)| {
-        let n = remaining(total, g);
-        // Gather the group's bins first: a loop of loads alone keeps many cache misses
-        // in flight (the groups' tallies are far apart in memory), the maths then runs
-        // on bins at hand.
-        scratch.rest.clear();
-        scratch.rest.extend(scored.0[index].iter().map(|i| {
-            let mut rest = total.flux.bins[i];
-            rest.merge_signed(&g.flux.bins[i], Sign::Remove);
-            (i, rest)
-        }));
-        let base = bases.get(n);
-        let m = &mut scratch.map;
-        m.value.clone_from(&base.value);
-        m.stderr.clone_from(&base.stderr);
-        for (i, b) in &scratch.rest {
-            (m.value[*i], m.stderr[*i]) = bin_value(b, n, bases.k);
-        }
-        let mut detected = total.ledger.detected;
-        detected.merge_signed(&g.ledger.detected, Sign::Remove);
-        let eff = detected.mean_and_stderr(n).0;
-        Metrics::of_flux(base.nx, base.ny, &m.value, &m.stderr, eff).values()
+    in_pool(used, |&(index, g)| {
+        SCRATCH.with_borrow_mut(|scratch| {
+            let n = remaining(total, g);
+            // Gather the group's bins first: a loop of loads alone keeps many cache
+            // misses in flight (the groups' tallies are far apart in memory), the maths
+            // then runs on bins at hand.
+            scratch.rest.clear();
+            scratch.rest.extend(scored.0[index].iter().map(|i| {
+                let mut rest = total.flux.bins[i];
+                rest.merge_signed(&g.flux.bins[i], Sign::Remove);
+                (i, rest)
+            }));
+            let base = bases.get(n);
+            let m = &mut scratch.map;
+            m.value.clone_from(&base.value);
+            m.stderr.clone_from(&base.stderr);
+            for (i, b) in &scratch.rest {
+                (m.value[*i], m.stderr[*i]) = bin_value(b, n, bases.k);
+            }
+            let mut detected = total.ledger.detected;
+            detected.merge_signed(&g.ledger.detected, Sign::Remove);
+            let eff = detected.mean_and_stderr(n).0;
+            Metrics::of_flux(base.nx, base.ny, &m.value, &m.stderr, eff).values()
+        })
     })
 }
 
-/// One worker's buffers for leave-out maps, reused from group to group.
+thread_local! {
+    /// This thread's buffers for leave-out maps, kept from group to group and from round
+    /// to round (a run's pool threads live as long as the run).
+    static SCRATCH: RefCell<Scratch> = RefCell::default();
+    /// The buffers of the last bases this thread built, for its next ones.
+    static SPARE_MAPS: RefCell<Vec<FluxValues>> = RefCell::default();
+}
+
+/// One thread's buffers for leave-out maps.
 #[derive(Default)]
 struct Scratch {
     /// The group's bins taken out of the total's.
@@ -192,20 +203,19 @@ struct Scratch {
     map: FluxValues,
 }
 
-/// `f` of every item, in order, with a scratch value from `init` that `f` may reuse
-/// between items: in parallel on the current rayon pool when called from one (a run's
-/// own, sized by `--threads`), else sequentially, so that no caller starts rayon's global
-/// pool behind the user's thread count.
-fn in_pool<T: Sync, S, R: Send>(
-    items: &[T],
-    init: impl Fn() -> S + Sync + Send,
-    f: impl Fn(&mut S, &T) -> R + Sync + Send,
-) -> Vec<R> {
-    if rayon::current_thread_index().is_some() {
-        items.par_iter().map_init(init, f).collect()
+/// In parallel on the current rayon pool when called from one (a run's own, sized by
+/// `--threads`), else sequentially, so that no caller starts rayon's global pool behind
+/// the user's thread count.
+fn in_pool_parallel() -> bool {
+    rayon::current_thread_index().is_some()
+}
+
+/// `f` of every item, in order ([`in_pool_parallel`]).
+fn in_pool<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
+    if in_pool_parallel() {
+        items.par_iter().map(f).collect()
     } else {
-        let mut scratch = init();
-        items.iter().map(|item| f(&mut scratch, item)).collect()
+        items.iter().map(f).collect()
     }
 }
 
@@ -224,20 +234,24 @@ impl FluxBases {
         let mut counts: Vec<u64> = counts.collect();
         counts.sort_unstable();
         counts.dedup();
+        let mut maps = SPARE_MAPS.with_borrow_mut(std::mem::take);
+        maps.resize_with(counts.len(), FluxValues::default);
         let g = &total.flux;
-        let maps = in_pool(
-            &counts,
-            || (),
-            |_, &n| {
-                let (value, stderr) = g.bins.iter().map(|b| bin_value(b, n, k)).unzip();
-                FluxValues {
-                    nx: g.nx,
-                    ny: g.ny,
-                    value,
-                    stderr,
-                }
-            },
-        );
+        let fill = |(m, &n): (&mut FluxValues, &u64)| {
+            (m.nx, m.ny) = (g.nx, g.ny);
+            m.value.clear();
+            m.stderr.clear();
+            for b in &g.bins {
+                let (value, stderr) = bin_value(b, n, k);
+                m.value.push(value);
+                m.stderr.push(stderr);
+            }
+        };
+        if in_pool_parallel() {
+            maps.par_iter_mut().zip(&counts).for_each(fill);
+        } else {
+            maps.iter_mut().zip(&counts).for_each(fill);
+        }
         FluxBases { k, counts, maps }
     }
 
@@ -246,5 +260,11 @@ impl FluxBases {
             .counts
             .binary_search(&n)
             .expect("a count the bases were built for")]
+    }
+}
+
+impl Drop for FluxBases {
+    fn drop(&mut self) {
+        SPARE_MAPS.with_borrow_mut(|spare| *spare = std::mem::take(&mut self.maps));
     }
 }

@@ -210,7 +210,10 @@ impl MapSums {
         for (&v, &e) in value.iter().zip(stderr) {
             s.value += v;
             s.stderr_sq += e * e;
-            (s.lo, s.hi) = (s.lo.min(v), s.hi.max(v));
+            // `f64::min`/`max` as plain selects (twice as fast a loop): the same
+            // result for any `v`, NaN included, as values are never -0.0.
+            s.lo = if v < s.lo { v } else { s.lo };
+            s.hi = if v > s.hi { v } else { s.hi };
             if v > 0.0 {
                 s.rel += e / v;
                 s.lit += 1;

@@ -14,6 +14,7 @@
 
 use crate::optics::surface::Estimator;
 use crate::output::atomic::OutputSet;
+use crate::run::metrics::ScoredBins;
 use crate::run::{ConvergenceRow, RunOptions, RunResult, Shard, StoppedBy, metrics};
 use crate::scene::Scene;
 use crate::tally::Tally;
@@ -207,12 +208,12 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
     let mut total = Tally::new(scene);
     groups.iter().for_each(|g| total.merge(g));
     let runtime_s: f64 = shards.iter().map(|(_, s)| s.runtime_s).sum();
-    let (values, stderr) = metrics::with_errors(scene, &total, &groups);
+    let e = metrics::estimates(scene, &total, &groups, &ScoredBins::of(&groups));
     let row = ConvergenceRow {
         photons: total.ledger.photons,
         seconds: runtime_s,
-        values,
-        stderr,
+        values: e.values,
+        stderr: e.stderr,
     };
     let backends: Vec<&str> = shards.iter().map(|(_, s)| s.backend.as_str()).collect();
     Ok(RunResult {
@@ -231,6 +232,7 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
         runtime_s,
         stopped_by: StoppedBy::Photons,
         history: vec![row],
+        leave_out: e.leave_out,
     })
 }
 

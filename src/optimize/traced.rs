@@ -2,6 +2,7 @@
 
 use super::objective::Evaluation;
 use super::search::dots_pattern;
+use crate::run::metrics::MetricValues;
 use crate::run::{self, ConvergenceRow, RunOptions, RunResult, StoppedBy};
 use crate::scene::Scene;
 use crate::tally::Tally;
@@ -20,6 +21,7 @@ pub struct TracedRun {
     runtime_s: f64,
     stopped_by: StoppedBy,
     history: Vec<ConvergenceRow>,
+    leave_out: Vec<MetricValues>,
 }
 
 impl TracedRun {
@@ -64,6 +66,7 @@ impl TracedRun {
             runtime_s,
             stopped_by,
             history,
+            leave_out,
         } = r;
         let traced = TracedRun {
             scene,
@@ -75,6 +78,7 @@ impl TracedRun {
             runtime_s,
             stopped_by,
             history,
+            leave_out,
         };
         Ok((traced, judged))
     }
@@ -91,6 +95,7 @@ impl TracedRun {
             runtime_s: self.runtime_s,
             stopped_by: self.stopped_by,
             history: self.history.clone(),
+            leave_out: self.leave_out.clone(),
         }
     }
 }

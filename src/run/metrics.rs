@@ -13,7 +13,8 @@
 mod jackknife;
 
 pub use jackknife::{
-    BinSet, ScoredBins, jackknife, jackknife_stderr, leave_one_out, with_errors, with_errors_scored,
+    BinSet, Estimates, ScoredBins, estimates, jackknife, jackknife_stderr, leave_one_out,
+    with_errors,
 };
 
 use crate::scene::Scene;

@@ -206,6 +206,9 @@ pub struct RunResult<'a> {
     pub stopped_by: StoppedBy,
     /// Metrics and errors after each round.
     pub history: Vec<ConvergenceRow>,
+    /// Every metric with each group holding photons left out in turn, after the last
+    /// round (for jackknife errors of any function of the metrics).
+    pub leave_out: Vec<MetricValues>,
 }
 
 /// Most memory (bytes) a run's tallies may take: the run's own flux and angular grids and
@@ -299,6 +302,7 @@ pub fn trace<'a>(
         runtime_s: start.elapsed().as_secs_f64(),
         stopped_by,
         history: state.history,
+        leave_out: state.leave_out,
     })
 }
 
@@ -315,6 +319,8 @@ struct Rounds {
     /// The flux bins each group has scored in (for the jackknife).
     scored: ScoredBins,
     history: Vec<ConvergenceRow>,
+    /// The metrics with each group left out, after the last round.
+    leave_out: Vec<MetricValues>,
 }
 
 impl Rounds {
@@ -327,6 +333,7 @@ impl Rounds {
             groups: vec![Tally::new(scene); GROUPS],
             scored: ScoredBins::new(GROUPS, scene.detector.bins[0] * scene.detector.bins[1]),
             history: Vec::new(),
+            leave_out: Vec::new(),
         }
     }
 
@@ -398,14 +405,14 @@ impl Rounds {
     }
 
     fn record(&mut self, scene: &Scene, seconds: f64) {
-        let (values, stderr) =
-            metrics::with_errors_scored(scene, &self.total, &self.groups, &self.scored);
+        let e = metrics::estimates(scene, &self.total, &self.groups, &self.scored);
         self.history.push(ConvergenceRow {
             photons: self.traced,
             seconds,
-            values,
-            stderr,
+            values: e.values,
+            stderr: e.stderr,
         });
+        self.leave_out = e.leave_out;
     }
 }
 

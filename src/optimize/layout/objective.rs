@@ -19,7 +19,7 @@
 //! perfectly uniform map would show at the search's photons, as for the dots objective.
 
 use crate::run::RunResult;
-use crate::run::metrics::{Metric, MetricValues, Metrics, jackknife_stderr, leave_one_out};
+use crate::run::metrics::{Metric, MetricValues, Metrics, jackknife_stderr};
 use serde::Serialize;
 
 /// One loss term of the objective.
@@ -127,7 +127,7 @@ impl ObjectiveSpec {
     pub fn evaluate(&self, run: &RunResult) -> LayoutEvaluation {
         let metrics = Metrics::of(run.scene, &run.tally);
         let values = metrics.values();
-        let leave_out = leave_one_out(run.scene, &run.tally, &run.groups);
+        let leave_out = &run.leave_out;
         let se = |f: &dyn Fn(&MetricValues) -> f64| {
             jackknife_stderr(&leave_out.iter().map(f).collect::<Vec<_>>())
         };

@@ -92,16 +92,25 @@ pub fn leave_one_out(scene: &Scene, total: &Tally, groups: &[Tally]) -> Vec<Metr
 /// efficiency, a mean over photons, gets its exact per-photon error, the one the summary
 /// reports, so the convergence history and the summary agree.
 pub fn with_errors(scene: &Scene, total: &Tally, groups: &[Tally]) -> (MetricValues, MetricValues) {
-    with_errors_scored(scene, total, groups, &ScoredBins::of(groups))
+    let e = estimates(scene, total, groups, &ScoredBins::of(groups));
+    (e.values, e.stderr)
 }
 
-/// [`with_errors`] when the bins each group scored in are known (noted while scoring).
-pub fn with_errors_scored(
-    scene: &Scene,
-    total: &Tally,
-    groups: &[Tally],
-    scored: &ScoredBins,
-) -> (MetricValues, MetricValues) {
+/// The metrics of a run with their jackknife errors and leave-one-out values.
+#[derive(Clone, Debug)]
+pub struct Estimates {
+    /// Every metric of the total.
+    pub values: MetricValues,
+    /// Their standard errors, as [`with_errors`] gives them.
+    pub stderr: MetricValues,
+    /// Every metric with each group holding photons left out in turn, as
+    /// [`leave_one_out`] gives them (for the error of any function of the metrics).
+    pub leave_out: Vec<MetricValues>,
+}
+
+/// [`Estimates`] of `total` over `groups`, whose scored bins are `scored` (noted while
+/// scoring, or [`ScoredBins::of`]).
+pub fn estimates(scene: &Scene, total: &Tally, groups: &[Tally], scored: &ScoredBins) -> Estimates {
     let used = used_groups(total, groups);
     let n = total.ledger.photons;
     let counts = used.iter().map(|(_, g)| remaining(total, g)).chain([n]);
@@ -109,10 +118,15 @@ pub fn with_errors_scored(
     let own = bases.get(n);
     let (eff, eff_se) = total.ledger.detected.mean_and_stderr(n);
     let values = Metrics::of_flux(own.nx, own.ny, &own.value, &own.stderr, eff).values();
-    let mut stderr = stderr_of(&leave_one_out_from(&bases, total, &used, scored));
+    let leave_out = leave_one_out_from(&bases, total, &used, scored);
+    let mut stderr = stderr_of(&leave_out);
     stderr[Metric::MeanRelStderr] = 0.0;
     stderr[Metric::Efficiency] = eff_se;
-    (values, stderr)
+    Estimates {
+        values,
+        stderr,
+        leave_out,
+    }
 }
 
 /// The jackknife standard error `sqrt((k - 1) / k sum (x_i - mean)^2)` of a statistic

@@ -256,8 +256,7 @@ impl Tracer<'_> {
         match self.estimator {
             // A photon leaving the scene inside an absorbing medium (t infinite: the
             // black surround the physics and stability tests use to catch leaks) is
-            // absorbed there; the weighted estimator books it escaped at its weight
-            // instead (noted on issue 18: the two should agree).
+            // absorbed there, under both estimators.
             Estimator::Analog => {
                 // Absorption is memoryless: one exponential depth per photon, spent
                 // segment by segment (a t each), has the law of a fresh free path per
@@ -273,11 +272,13 @@ impl Tracer<'_> {
                 Flight::Reached
             }
             Estimator::Weighted => {
-                // An escaping photon (t infinite) loses nothing more inside this medium.
+                // exp(-a t) at any length, to infinity included: a photon leaving the
+                // scene inside an absorbing medium leaves all its weight to it, as the
+                // analog photon is absorbed there.
                 let w = if t.is_finite() {
                     p.weight * (-a * t).exp()
                 } else {
-                    p.weight
+                    0.0
                 };
                 Ledger::lose(sink, p.weight, w);
                 p.weight = w;

@@ -156,6 +156,23 @@ fn isotropic_source_in_slab_traps_sqrt_one_minus_inverse_n_squared() {
     // The rest leaves through the faces (escaped, or detected above the front face).
     let out = r.tally.ledger.escaped.value() + r.tally.ledger.detected.sum.value();
     assert_eq!(out + trapped, n as f64);
+    // The weighted estimator books the same: a photon that leaves the scene inside the
+    // black medium leaves all its weight there (exp(-a t) as t goes to infinity).
+    let opts = blutrace::run::RunOptions {
+        photons: n,
+        seed: 5,
+        threads: Some(2),
+        estimator: Estimator::Weighted,
+        ..Default::default()
+    };
+    let w = trace_opts(&scene, &opts);
+    assert_balanced(&w);
+    let trapped_w = w.tally.ledger.absorbed_in_medium[black].value();
+    let (frac, sigma, ok) = within_sigma(trapped_w, n as f64, expect, 4.0);
+    assert!(
+        ok,
+        "weighted: trapped {frac:.5}, expected {expect:.5} (sigma {sigma:.1e})"
+    );
 }
 
 #[test]

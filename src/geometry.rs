@@ -112,6 +112,13 @@ impl Aabb {
         max: DVec3::splat(f64::NEG_INFINITY),
     };
 
+    /// The box holding `points` ([`Aabb::EMPTY`] when there are none).
+    pub fn of(points: impl IntoIterator<Item = DVec3>) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        points.into_iter().for_each(|p| b.grow(p));
+        b
+    }
+
     /// Grow the box to hold `p`.
     pub fn grow(&mut self, p: DVec3) {
         self.min = self.min.min(p);
@@ -200,13 +207,12 @@ impl Mesh {
 
     /// Bounding box of all vertices used by triangles.
     pub fn bounds(&self) -> Aabb {
-        let mut b = Aabb::EMPTY;
-        for tri in &self.triangles {
-            for &v in tri {
-                b.grow(self.positions[v as usize]);
-            }
-        }
-        b
+        Aabb::of(
+            self.triangles
+                .iter()
+                .flatten()
+                .map(|&v| self.positions[v as usize]),
+        )
     }
 
     /// True when `p`, a point on the plane of triangle `prim`, lies inside it (edges

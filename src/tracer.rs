@@ -87,10 +87,7 @@ impl Tracer<'_> {
             let true_ray = p.ray.true_ray();
             let surf = self.nearest_surface(p, &true_ray);
             let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
-            let detected = match self.convex_solid(p) {
-                Some(solid) if solid.clear_of_target => None,
-                _ => scene.detector.intersect(&true_ray, t_surface),
-            };
+            let detected = self.target_hit(p, &true_ray, t_surface);
             let t_next = detected.map_or(t_surface, |(t, _)| t);
             match self.cross_medium(p, &true_ray, t_next, rng, &mut out.ledger) {
                 Flight::Absorbed => return Fate::AbsorbedInMedium(p.medium),
@@ -151,6 +148,15 @@ impl Tracer<'_> {
         });
         let t_mesh = mesh.map_or(f64::INFINITY, |h| h.surf.t);
         self.nearest_body(p, t_mesh).or(mesh)
+    }
+
+    /// Where `true_ray` crosses the target plane before `t_surface`, if it does. Inside a
+    /// convex solid that lies wholly on one side of the target it cannot.
+    fn target_hit(&self, p: &Photon, true_ray: &Ray, t_surface: f64) -> Option<(f64, [f64; 2])> {
+        match self.convex_solid(p) {
+            Some(solid) if solid.clear_of_target => None,
+            _ => self.scene.detector.intersect(true_ray, t_surface),
+        }
     }
 
     /// The convex solid `p` travels in, when the fast path is on and its medium has one.

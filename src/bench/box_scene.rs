@@ -27,7 +27,8 @@
 //! Coordinates are the loaded scene's (recentred, so within a few hundred mm of the
 //! origin): `f32` keeps positions to a few nanometres there, far below the dot sizes.
 
-use crate::optics::density::{Density, XUnit};
+use crate::geometry::Aabb;
+use crate::optics::density::{Density, graded_x};
 use crate::optics::dots::{Lattice, Placement};
 use crate::optics::surface::SurfaceModel;
 use crate::scene::Scene;
@@ -194,10 +195,8 @@ fn refuse(scene: &Scene, why: impl std::fmt::Display) -> anyhow::Error {
 }
 
 fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {
-    pts.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
+    let b = Aabb::of(pts.iter().copied());
+    (b.min, b.max)
 }
 
 /// The axis and sign of a unit vector along a coordinate axis.
@@ -380,7 +379,7 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
     let r2 = (lo_col..=hi_col)
         .map(|i| {
             let u = (f64::from(i) + 0.5) * p;
-            let x = graded(u, pattern.length, pattern.x_unit, pattern.mirror);
+            let x = graded_x(u, pattern.length, pattern.x_unit, pattern.mirror);
             let d = coeffs.iter().rev().fold(0.0, |acc, c| acc * x + c);
             (d.max(0.0) * p * p / PI) as f32
         })
@@ -395,21 +394,6 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
         r2,
         ink_albedo: ink_albedo as f32,
     })
-}
-
-/// The grading variable at `u` mm along the axis (the dots model's convention: clamped to
-/// the span, from the nearer edge when mirrored, normalized or in mm).
-fn graded(u: f64, length: f64, unit: XUnit, mirror: bool) -> f64 {
-    let u = u.clamp(0.0, length);
-    let (dist, span) = if mirror {
-        (u.min(length - u), 0.5 * length)
-    } else {
-        (u, length)
-    };
-    match unit {
-        XUnit::Normalized => dist / span,
-        XUnit::Mm => dist,
-    }
 }
 
 /// The one Lambertian sheet: every triangle outside the guide, one flat rectangle.

@@ -4,7 +4,7 @@
 //! the detector plane cutting through a part; lamps cutting parts: [`super::lamp_placement`]).
 
 use crate::detector::TargetPlane;
-use crate::geometry::Mesh;
+use crate::geometry::{Aabb, Mesh};
 use glam::DVec3;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -23,13 +23,10 @@ pub struct BoxMm {
 
 impl BoxMm {
     fn of(points: impl Iterator<Item = DVec3>) -> Option<BoxMm> {
-        let (lo, hi) = points.fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(p), hi.max(p)),
-        );
-        (lo.x <= hi.x).then(|| BoxMm {
-            min: lo.to_array(),
-            max: hi.to_array(),
+        let b = Aabb::of(points);
+        (!b.is_empty()).then(|| BoxMm {
+            min: b.min.to_array(),
+            max: b.max.to_array(),
         })
     }
 

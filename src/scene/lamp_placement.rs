@@ -16,7 +16,7 @@
 
 use super::geometry_report::Plane;
 use super::solids;
-use crate::geometry::Mesh;
+use crate::geometry::{Aabb, Mesh};
 use crate::optics::medium::{Interface, Medium};
 use crate::sources::{Emitter, Source};
 use crate::spec_check::Ctx;
@@ -234,11 +234,8 @@ fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
 }
 
 fn bounds(points: impl Iterator<Item = DVec3>, pad: f64) -> (DVec3, DVec3) {
-    let (lo, hi) = points.fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p), hi.max(p)),
-    );
-    (lo - pad, hi + pad)
+    let b = Aabb::of(points);
+    (b.min - pad, b.max + pad)
 }
 
 fn mm(p: DVec3) -> String {

@@ -31,6 +31,11 @@ pub struct ConvexSolid {
     /// Plane normals and offsets packed for the exit loop.
     normals: Vec<DVec3>,
     offsets: Vec<f64>,
+    /// The solid as an axis-aligned box, when it is one (six planes with unit axis
+    /// normals, as most light guides are): its exit is then three divisions, independent
+    /// of each other, instead of a chain of six plane tests (7 % more photons/s on
+    /// bench-box).
+    axis_box: Option<AxisBox>,
     /// True when the whole solid lies strictly on one side of the scene's target plane
     /// (set by the scene): a photon inside can then never cross the target before it
     /// leaves, and the tracer skips that test.
@@ -68,7 +73,8 @@ impl ConvexSolid {
             .all(|v| planes.iter().all(|q| q.normal.dot(v) - q.offset <= tol));
         let normals = planes.iter().map(|q| q.normal).collect();
         let offsets = planes.iter().map(|q| q.offset).collect();
-        (convex && planes.len() >= 4).then_some(ConvexSolid {
+        (convex && planes.len() >= 4).then(|| ConvexSolid {
+            axis_box: AxisBox::of(&planes),
             planes,
             normals,
             offsets,
@@ -91,19 +97,10 @@ impl ConvexSolid {
     /// Where a ray starting inside leaves the solid: nearest plane ahead, and the
     /// triangle of that plane holding the exit point.
     pub fn exit(&self, mesh: &Mesh, ray: &Ray) -> Option<Hit> {
-        // The nearest plane ahead is the least `num / den` over planes with `den > 0`; the
-        // fractions are compared cross-multiplied (`den > 0`), so one division is left
-        // (30 % more queries per second than a division per plane).
-        let (mut num, mut den, mut best) = (1.0, 0.0, usize::MAX);
-        for (i, (n, offset)) in self.normals.iter().zip(&self.offsets).enumerate() {
-            let den_i = n.dot(ray.dir);
-            let num_i = (offset - n.dot(ray.origin)).max(0.0);
-            let nearer = den_i > 0.0 && num_i * den < num * den_i;
-            num = if nearer { num_i } else { num };
-            den = if nearer { den_i } else { den };
-            best = if nearer { i } else { best };
-        }
-        let t = num / den;
+        let (t, best) = match &self.axis_box {
+            Some(b) => b.exit(ray)?,
+            None => self.nearest_plane(ray),
+        };
         let plane = self.planes.get(best)?;
         if plane.one_tag {
             return Some(Hit {
@@ -116,6 +113,96 @@ impl ConvexSolid {
             outside_distance(mesh, a, point).total_cmp(&outside_distance(mesh, b, point))
         })?;
         Some(Hit { t, prim })
+    }
+
+    /// The distance to the nearest plane ahead of `ray` and its index (`usize::MAX` when
+    /// no plane is ahead).
+    fn nearest_plane(&self, ray: &Ray) -> (f64, usize) {
+        // The nearest plane ahead is the least `num / den` over planes with `den > 0`; the
+        // fractions are compared cross-multiplied (`den > 0`), so one division is left
+        // (30 % more queries per second than a division per plane).
+        let (mut num, mut den, mut best) = (1.0, 0.0, usize::MAX);
+        for (i, (n, offset)) in self.normals.iter().zip(&self.offsets).enumerate() {
+            let den_i = n.dot(ray.dir);
+            let num_i = (offset - n.dot(ray.origin)).max(0.0);
+            let nearer = den_i > 0.0 && num_i * den < num * den_i;
+            num = if nearer { num_i } else { num };
+            den = if nearer { den_i } else { den };
+            best = if nearer { i } else { best };
+        }
+        (num / den, best)
+    }
+}
+
+/// An axis-aligned box solid: its six planes by axis and side.
+#[derive(Clone, Debug)]
+struct AxisBox {
+    /// Low and high corner.
+    lo: DVec3,
+    hi: DVec3,
+    /// Index into the solid's planes of the low and the high face of each axis.
+    lo_plane: [usize; 3],
+    hi_plane: [usize; 3],
+}
+
+impl AxisBox {
+    /// The box, if `planes` are six with normals exactly `-e_k` and `+e_k` (a mesh normal
+    /// of an axis-aligned face is exact: its cross product has two exact zeros).
+    fn of(planes: &[Plane]) -> Option<AxisBox> {
+        if planes.len() != 6 {
+            return None;
+        }
+        let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
+        let (mut lo_plane, mut hi_plane) = ([usize::MAX; 3], [usize::MAX; 3]);
+        for (i, q) in planes.iter().enumerate() {
+            let k = (0..3).find(|&k| q.normal[k].abs() == 1.0)?;
+            if q.normal[k] > 0.0 {
+                (hi[k], hi_plane[k]) = (q.offset, i);
+            } else {
+                (lo[k], lo_plane[k]) = (-q.offset, i);
+            }
+        }
+        let complete = lo_plane.iter().chain(&hi_plane).all(|&i| i != usize::MAX);
+        complete.then_some(AxisBox {
+            lo,
+            hi,
+            lo_plane,
+            hi_plane,
+        })
+    }
+
+    /// The distance to the face ahead of `ray` and its plane index: per axis, the face
+    /// the direction points to, the nearest of the three. Each distance is the same f64 as
+    /// [`ConvexSolid::nearest_plane`] computes for that plane (a unit axis normal makes its
+    /// dot products exact), and a ray starting outside a face it heads for is at
+    /// distance 0, as there.
+    fn exit(&self, ray: &Ray) -> Option<(f64, usize)> {
+        let (o, d) = (ray.origin.to_array(), ray.dir.to_array());
+        let (lo, hi) = (self.lo.to_array(), self.hi.to_array());
+        // Written as selects, not branches: which face a photon heads for is a coin toss
+        // the branch predictor loses (4 % more photons/s on bench-box than with branches).
+        let mut best = (f64::INFINITY, usize::MAX);
+        for k in 0..3 {
+            let ahead_high = d[k] > 0.0;
+            let gap = if ahead_high {
+                hi[k] - o[k]
+            } else {
+                o[k] - lo[k]
+            };
+            let plane = if ahead_high {
+                self.hi_plane[k]
+            } else {
+                self.lo_plane[k]
+            };
+            // A zero component gives infinity or NaN here, never nearer: no face ahead.
+            let t = gap.max(0.0) / d[k].abs();
+            let nearer = t < best.0;
+            best = (
+                if nearer { t } else { best.0 },
+                if nearer { plane } else { best.1 },
+            );
+        }
+        (best.1 != usize::MAX).then_some(best)
     }
 }
 
@@ -182,6 +269,43 @@ mod tests {
             // One tag per face: any triangle of the exit plane is the same surface.
             assert_eq!(mesh.normal(a.prim), mesh.normal(b.prim));
         }
+    }
+
+    /// The box exit is the plane loop's exit, bit for bit, on a box off the origin with
+    /// rays from inside, on its faces and heading along them.
+    #[test]
+    fn box_exit_is_the_plane_exit() {
+        let mut mesh = cube();
+        let (scale, shift) = (DVec3::new(120.0, 80.0, 3.0), DVec3::new(-60.0, -40.0, 7.5));
+        mesh.positions
+            .iter_mut()
+            .for_each(|p| *p = *p * scale + shift);
+        let prims: Vec<u32> = (0..12).collect();
+        let solid = ConvexSolid::from_triangles(&mesh, &prims, 1e-9).unwrap();
+        let b = solid.axis_box.as_ref().expect("an axis-aligned box");
+        let mut rng = crate::rng::PhotonRng::new(3, 0);
+        for i in 0..20_000 {
+            let mut u = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+            u[i % 3] = [0.0, 1.0, u[i % 3]][(i / 3) % 3]; // on a face, or inside
+            let mut d =
+                crate::optics::sampling::around(DVec3::Z, 2.0 * rng.uniform() - 1.0, rng.uniform());
+            if i % 7 == 0 {
+                d[i % 3] = 0.0; // along a face
+            }
+            let ray = Ray::new(u * scale + shift, d);
+            let want = solid.nearest_plane(&ray);
+            match b.exit(&ray) {
+                Some(got) => assert_eq!(got, want, "{ray:?}"),
+                None => assert_eq!(want.1, usize::MAX),
+            }
+        }
+        let sheared = {
+            let mut m = mesh.clone();
+            m.positions.iter_mut().for_each(|p| p.x += 0.1 * p.z);
+            m
+        };
+        let wedge = ConvexSolid::from_triangles(&sheared, &prims, 1e-9).unwrap();
+        assert!(wedge.axis_box.is_none(), "tilted faces are not a box");
     }
 
     #[test]

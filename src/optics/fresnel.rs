@@ -20,12 +20,19 @@ pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
     let cos_i = cos_i.clamp(0.0, 1.0);
     match cos_transmitted(cos_i, n1, n2) {
         None => 1.0,
-        Some(cos_t) => {
-            let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
-            let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
-            0.5 * (rs * rs + rp * rp)
-        }
+        Some(cos_t) => reflectance_with(cos_i, cos_t, n1, n2),
     }
+}
+
+/// [`reflectance`] below the critical angle, given the refraction cosine `cos_t` of
+/// `cos_i` (in `[0, 1]`).
+fn reflectance_with(cos_i: f64, cos_t: f64, n1: f64, n2: f64) -> f64 {
+    if n1 == n2 {
+        return 0.0;
+    }
+    let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
+    let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
+    0.5 * (rs * rs + rp * rp)
 }
 
 /// Cosine of the refraction angle by Snell's law, or `None` under total internal reflection.
@@ -54,8 +61,13 @@ pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
 pub fn refract(dir: DVec3, n: DVec3, n1: f64, n2: f64) -> Option<DVec3> {
     let cos_i = -dir.dot(n);
     let cos_t = cos_transmitted(cos_i, n1, n2)?;
-    let eta = n1 / n2;
-    Some((eta * dir + (eta * cos_i - cos_t) * n).normalize())
+    Some(refracted(dir, n, cos_i, cos_t, n1 / n2))
+}
+
+/// The refracted direction of unit `dir` through unit `n` (facing the incident side)
+/// with incidence and refraction cosines `cos_i`, `cos_t` and `eta = n1 / n2`.
+fn refracted(dir: DVec3, n: DVec3, cos_i: f64, cos_t: f64, eta: f64) -> DVec3 {
+    (eta * dir + (eta * cos_i - cos_t) * n).normalize()
 }
 
 /// The Fresnel roulette of unit `dir` meeting a surface of unit normal `facing` (facing
@@ -65,11 +77,15 @@ pub fn refract(dir: DVec3, n: DVec3, n1: f64, n2: f64) -> Option<DVec3> {
 ///
 /// One uniform is drawn, unless R = 1.
 pub fn roulette(dir: DVec3, facing: DVec3, n1: f64, n2: f64, rng: &mut PhotonRng) -> Option<DVec3> {
-    let r = reflectance(-dir.dot(facing), n1, n2);
+    // [`reflectance`] then [`refract`], sharing the cosines: total internal reflection
+    // (most hits inside a guide) leaves after one square root and no draw.
+    let cos_i = -dir.dot(facing);
+    let cos_t = cos_transmitted(cos_i, n1, n2)?;
+    let r = reflectance_with(cos_i.clamp(0.0, 1.0), cos_t, n1, n2);
     if r >= 1.0 || rng.uniform() < r {
         return None;
     }
-    refract(dir, facing, n1, n2)
+    Some(refracted(dir, facing, cos_i, cos_t, n1 / n2))
 }
 
 #[cfg(test)]

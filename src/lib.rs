@@ -15,6 +15,7 @@ pub mod optics;
 pub mod optimize;
 pub mod output;
 pub mod rng;
+pub mod rounding;
 pub mod run;
 pub mod scene;
 pub mod shard;

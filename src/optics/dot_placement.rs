@@ -36,6 +36,7 @@
 
 use super::dots::{DotPattern, Lattice};
 use crate::rng::PhotonRng;
+use crate::rounding::{floor_i64, round_i64};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::{DVec2, DVec3};
@@ -153,16 +154,16 @@ impl DotPattern {
         let p = self.pitch;
         match self.lattice {
             Lattice::Square => {
-                let (i, j) = ((q.x / p).floor() as i64, (q.y / p).floor() as i64);
+                let (i, j) = (floor_i64(q.x / p), floor_i64(q.y / p));
                 (i, j, self.cell_centre(i, j))
             }
             Lattice::Hex => {
                 // The two rows around q; in each, the column nearest q; the nearer wins
                 // (the first on a tie).
-                let j0 = (q.y / self.row_spacing() - 0.5).floor() as i64;
+                let j0 = floor_i64(q.y / self.row_spacing() - 0.5);
                 let candidate = |j: i64| {
                     let shift = if j.rem_euclid(2) == 1 { 0.5 * p } else { 0.0 };
-                    let i = ((q.x - shift) / p - 0.5).round() as i64;
+                    let i = round_i64((q.x - shift) / p - 0.5);
                     let c = self.cell_centre(i, j);
                     (i, j, c, c.distance_squared(q))
                 };
@@ -279,10 +280,7 @@ impl DotPattern {
                 inside(self.cell_dot(i, j))
             }
             Placement::Stochastic => {
-                let (bi, bj) = (
-                    (q.x / self.pitch).floor() as i64,
-                    (q.y / self.pitch).floor() as i64,
-                );
+                let (bi, bj) = (floor_i64(q.x / self.pitch), floor_i64(q.y / self.pitch));
                 // Its own bucket first, then the neighbours a dot could reach across from.
                 let near = (bj - 1..=bj + 1).flat_map(|j| (bi - 1..=bi + 1).map(move |i| (i, j)));
                 self.bucket_dots(bi, bj).any(inside)

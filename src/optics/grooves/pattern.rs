@@ -4,6 +4,7 @@
 use crate::optics::density::Gradation;
 use crate::optics::fresnel;
 use crate::rng::PhotonRng;
+use crate::rounding::floor_i64;
 use glam::DVec3;
 
 /// Cells a photon's path may cross in the groove layer at one surface hit before the
@@ -98,7 +99,7 @@ impl GroovePattern {
 
     /// Index of the cell holding `s` (mm along `axis` from `origin`).
     fn cell_index(&self, s: f64) -> i64 {
-        (s / self.pitch).floor() as i64
+        floor_i64(s / self.pitch)
     }
 
     /// Fill fraction of cell `k` (the polynomial at its centre, clamped to `[0, 1]`).

@@ -158,6 +158,73 @@ impl TargetPlane {
     }
 }
 
+/// [`TargetPlane::angular_index`] without inverse trigonometry, for the photon loop: the
+/// polar bin from `cos theta` against the cosines of the bin edges, the azimuthal bin
+/// from a pseudo-angle (monotone in phi, one division) against the pseudo-angles of the
+/// edges. `acos` and `atan2` took about 1.5 % of a photon on bench-box. The two agree
+/// except for directions within rounding (~1e-15 rad) of a bin edge, where either bin is
+/// as right as the other (tested).
+#[derive(Clone, Debug)]
+pub struct AngularBinning {
+    normal: DVec3,
+    u: DVec3,
+    v: DVec3,
+    /// Theta bins.
+    nt: usize,
+    /// `cos` of the inner theta edges, decreasing (edge `k` at `k * 90 / nt` degrees).
+    cos_edges: Vec<f64>,
+    /// Pseudo-angles of the inner phi edges, increasing (edge `k` at `k * 360 / np`).
+    phi_edges: Vec<f64>,
+}
+
+impl AngularBinning {
+    /// The binning of `plane`'s angular grid.
+    pub fn new(plane: &TargetPlane) -> AngularBinning {
+        let [nt, np] = plane.angular_bins;
+        let edge = |k: usize, n: usize, span: f64| span * k as f64 / n as f64;
+        AngularBinning {
+            normal: plane.normal(),
+            u: plane.u,
+            v: plane.v,
+            nt,
+            cos_edges: (1..nt).map(|k| edge(k, nt, FRAC_PI_2).cos()).collect(),
+            phi_edges: (1..np)
+                .map(|k| {
+                    let phi = edge(k, np, TAU);
+                    pseudo_angle(phi.cos(), phi.sin())
+                })
+                .collect(),
+        }
+    }
+
+    /// The index of `dir`'s bin in the angular grid (theta fastest), as
+    /// [`TargetPlane::angular_index`].
+    pub fn index(&self, dir: DVec3) -> usize {
+        let cos_t = dir.dot(self.normal);
+        let it = self.cos_edges.partition_point(|&c| c >= cos_t);
+        let phi = pseudo_angle(dir.dot(self.u), dir.dot(self.v));
+        let ip = self.phi_edges.partition_point(|&e| e <= phi);
+        ip * self.nt + it
+    }
+}
+
+/// A number in `[0, 4)` that increases with the azimuth `atan2(y, x)` taken in `[0, 2 pi)`
+/// (the "diamond angle": the position along the unit diamond `|x| + |y| = 1`).
+fn pseudo_angle(x: f64, y: f64) -> f64 {
+    let l1 = x.abs() + y.abs();
+    if l1 == 0.0 {
+        return 0.0;
+    }
+    // y = -0 counts as the upper half, as atan2(-0, x) taken modulo 2 pi does for x > 0.
+    if y >= 0.0 {
+        if x >= 0.0 { y / l1 } else { 1.0 - x / l1 }
+    } else if x < 0.0 {
+        2.0 - y / l1
+    } else {
+        3.0 + x / l1
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,5 +262,56 @@ mod tests {
             .map(|it| p.angular_bin_projected_solid_angle(it) * 12.0)
             .sum();
         assert!((projected - std::f64::consts::PI).abs() < 1e-12);
+    }
+
+    /// The fast binning agrees with `acos`/`atan2` everywhere but within rounding of an
+    /// edge: on 200,000 directions spread over the hemisphere, on the bin edges
+    /// themselves and on the axes, for a tilted plane and several grids.
+    #[test]
+    fn angular_binning_matches_the_trigonometric_one() {
+        let mut rng = crate::rng::PhotonRng::new(7, 0);
+        for (nt, np) in [(9, 12), (18, 36), (1, 1), (7, 5), (90, 360)] {
+            let mut p = plane();
+            p.angular_bins = [nt, np];
+            let (a, b) = (0.3f64, 1.1f64);
+            p.u = DVec3::new(a.cos(), a.sin(), 0.0);
+            let n = DVec3::new(b.sin() * 0.6, b.sin() * 0.8, b.cos());
+            p.u = (p.u - n * p.u.dot(n)).normalize();
+            p.v = n.cross(p.u);
+            let fast = AngularBinning::new(&p);
+            let mut dirs: Vec<(f64, f64)> = (0..200_000)
+                .map(|_| ((rng.uniform()).acos(), TAU * rng.uniform()))
+                .collect();
+            for k in 0..=4 * np {
+                dirs.push((0.7, TAU * k as f64 / (4 * np) as f64));
+            }
+            for k in 0..=nt {
+                dirs.push((FRAC_PI_2 * k as f64 / nt as f64, 1.0));
+            }
+            dirs.extend([(0.0, 0.0), (FRAC_PI_2, 0.0), (1.0, std::f64::consts::PI)]);
+            let mut differ = 0;
+            for (i, (theta, phi)) in dirs.into_iter().enumerate() {
+                let s = theta.sin();
+                let d = p.u * (s * phi.cos()) + p.v * (s * phi.sin()) + p.normal() * theta.cos();
+                let (want, got) = (p.angular_index(d), fast.index(d));
+                if want != got {
+                    // Only at an edge: the two bins are neighbours and the direction lies
+                    // within rounding of the edge between them.
+                    let (t, f) = p.angles(d);
+                    let frac_t = t / FRAC_PI_2 * nt as f64;
+                    let frac_p = f / TAU * np as f64;
+                    let near = |x: f64| (x - x.round()).abs() < 1e-9;
+                    assert!(
+                        near(frac_t) || near(frac_p),
+                        "{nt}x{np}: {d:?} {want} {got}"
+                    );
+                    differ += usize::from(i < 200_000);
+                }
+            }
+            assert!(
+                differ < 5,
+                "{nt}x{np}: {differ} random directions binned apart"
+            );
+        }
     }
 }

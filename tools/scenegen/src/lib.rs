@@ -16,6 +16,8 @@ use std::io;
 use std::path::Path;
 
 pub mod scenes;
+pub mod shapes;
+pub mod templates;
 
 /// A point (mm).
 pub type P3 = [f64; 3];
@@ -361,20 +363,22 @@ impl LampHolder {
 
 /// How an OBJ file names its tags.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ObjTags {
+pub enum ObjTags<'a> {
     /// `usemtl TAG` before each group (with a `mtllib` line naming this file).
-    Usemtl(&'static str),
+    Usemtl(&'a str),
     /// No materials: each part is one tag, named by an `o` line (even parts) or a `g`
     /// line (odd parts).
     ObjectNames,
 }
 
+/// Every line of `header` after `# ` (blank lines too, unlike [`comment`]).
+fn hash_lines(header: &str) -> String {
+    header.lines().map(|l| format!("# {l}\n")).collect()
+}
+
 /// An OBJ file of `parts`, each an `o` object; vertex indices are global and 1-based.
 pub fn write_obj(header: &str, parts: &[Part], tags: ObjTags) -> String {
-    let mut s = String::new();
-    for line in header.lines() {
-        writeln!(s, "# {line}").unwrap();
-    }
+    let mut s = hash_lines(header);
     if let ObjTags::Usemtl(mtl) = tags {
         writeln!(s, "mtllib {mtl}").unwrap();
     }
@@ -423,10 +427,7 @@ pub fn tag_colour(tag: &str) -> [f64; 3] {
 
 /// A `.mtl` file with one display material per tag.
 pub fn write_mtl(header: &str, tags: &[&str]) -> String {
-    let mut s = String::new();
-    for line in header.lines() {
-        writeln!(s, "# {line}").unwrap();
-    }
+    let mut s = hash_lines(header);
     for tag in tags {
         let c = tag_colour(tag);
         writeln!(
@@ -455,6 +456,11 @@ pub fn tags_of(parts: &[Part]) -> Vec<&str> {
         }
     }
     tags
+}
+
+/// Number of triangles of all `parts`.
+pub fn triangle_count(parts: &[Part]) -> usize {
+    parts.iter().map(Part::triangle_count).sum()
 }
 
 /// World millimetres, z up, to glTF's metres, y up.

@@ -101,6 +101,15 @@ pub fn dielectric(tag: &str, inside: &str) -> String {
     format!("[surfaces.{tag}]\nmodel = \"dielectric\"\ninside = \"{inside}\"\n")
 }
 
+/// A rough dielectric interface `[surfaces.TAG]` (model `diffuser`: GGX microfacets of
+/// roughness alpha `roughness`) with medium `inside` behind it.
+pub fn rough_dielectric(tag: &str, inside: &str, roughness: f64) -> String {
+    format!(
+        "[surfaces.{tag}]\nmodel = \"diffuser\"\ninside = \"{inside}\"\nroughness = {}\n",
+        num(roughness)
+    )
+}
+
 /// The three smooth faces of a dot-free light guide of medium `inside`, in the order
 /// front, back, edge.
 pub fn bare_guide_faces(inside: &str) -> [String; 3] {

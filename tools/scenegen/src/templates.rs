@@ -421,15 +421,18 @@ pub enum MtlNote {
     DisplayOnly,
 }
 
-/// `folder/stem.obj` (its `usemtl` names are the tags) and `folder/stem.mtl`, the display
-/// materials of its tags, both headed by `header`.
+/// `folder/NAME.obj` (`obj`; its `usemtl` names are the tags) and `folder/NAME.mtl`, the
+/// display materials of its tags, both headed by `header`.
 pub fn obj_and_mtl(
     folder: &str,
-    stem: &str,
+    obj: &str,
     header: &str,
     parts: &[Part],
     note: MtlNote,
 ) -> [GenFile; 2] {
+    let stem = obj
+        .strip_suffix(".obj")
+        .expect("an OBJ file name ends in .obj");
     let mtl = format!("{stem}.mtl");
     let mtl_header = match note {
         MtlNote::Plain => header.to_string(),
@@ -439,7 +442,7 @@ pub fn obj_and_mtl(
     };
     [
         GenFile::text(
-            &format!("{folder}/{stem}.obj"),
+            &format!("{folder}/{obj}"),
             write_obj(header, parts, ObjTags::Usemtl(&mtl)),
         ),
         GenFile::text(

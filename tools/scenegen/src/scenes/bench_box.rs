@@ -146,7 +146,13 @@ Geometry: bench-box.obj (tags are its usemtl names), {triangles} triangles.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
     let header = format!("bench-box: box guide and sheet (see scene.toml). Units mm.\n{GENERATED}");
-    let [obj, mtl] = obj_and_mtl("bench-box", "bench-box", &header, &parts, MtlNote::Plain);
+    let [obj, mtl] = obj_and_mtl(
+        "bench-box",
+        "bench-box.obj",
+        &header,
+        &parts,
+        MtlNote::Plain,
+    );
     vec![
         GenFile::text("bench-box/scene.toml", scene_toml(triangle_count(&parts))),
         obj,

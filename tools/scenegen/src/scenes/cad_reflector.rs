@@ -187,7 +187,7 @@ pub fn files() -> Vec<GenFile> {
     );
     let [obj, mtl] = obj_and_mtl(
         "cad-reflector",
-        "lgp",
+        "lgp.obj",
         &header,
         &parts,
         MtlNote::DisplayOnly,

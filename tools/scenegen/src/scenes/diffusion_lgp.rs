@@ -171,7 +171,7 @@ pub fn files() -> Vec<GenFile> {
         .collect();
     files.extend(obj_and_mtl(
         "diffusion-lgp",
-        "diffusion-lgp",
+        "diffusion-lgp.obj",
         &header,
         &parts,
         MtlNote::Plain,

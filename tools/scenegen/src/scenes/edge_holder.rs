@@ -108,7 +108,7 @@ pub fn files() -> Vec<GenFile> {
     let header = format!("edge-holder: guide and sheet (see scene.toml). Units mm.\n{GENERATED}");
     let [obj, mtl] = obj_and_mtl(
         "edge-holder",
-        "edge-holder",
+        "edge-holder.obj",
         &header,
         &parts,
         MtlNote::Plain,

@@ -184,7 +184,7 @@ pub fn files() -> Vec<GenFile> {
         format!("notebook14: 14-inch notebook backlight (see scene.toml). Units mm.\n{GENERATED}");
     let [obj, mtl] = obj_and_mtl(
         "notebook14",
-        "notebook14",
+        "notebook14.obj",
         &header,
         &parts,
         MtlNote::DisplayOnly,

@@ -316,7 +316,7 @@ pub fn files() -> Vec<GenFile> {
         format!("phone-led: LED edge-lit phone backlight (see scene.toml). Units mm.\n{GENERATED}");
     let [obj, mtl] = obj_and_mtl(
         "phone-led",
-        "phone-led",
+        "phone-led.obj",
         &header,
         &parts,
         MtlNote::DisplayOnly,

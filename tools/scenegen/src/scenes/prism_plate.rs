@@ -319,15 +319,15 @@ x_unit = \"normalized\"
 
 fn scene_files(meshed: bool) -> Vec<GenFile> {
     let parts = parts(meshed);
-    let (folder, stem) = if meshed {
-        ("test/prism-plate-meshed", "prism-plate-meshed")
+    let (folder, obj) = if meshed {
+        ("test/prism-plate-meshed", "prism-plate-meshed.obj")
     } else {
-        ("test/prism-plate", "prism-plate")
+        ("test/prism-plate", "prism-plate.obj")
     };
     let header = format!(
         "{folder}: edge-lit PMMA plate with V-groove extraction (see scene.toml). Units mm.\n{GENERATED}"
     );
-    let [obj, mtl] = obj_and_mtl(folder, stem, &header, &parts, MtlNote::Plain);
+    let [obj, mtl] = obj_and_mtl(folder, obj, &header, &parts, MtlNote::Plain);
     vec![
         GenFile::text(
             &format!("{folder}/scene.toml"),

@@ -86,7 +86,7 @@ Geometry: slab.obj (usemtl names are tags), {triangles} triangles.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
     let header = format!("test/slab: lossless PMMA slab (see scene.toml). Units mm.\n{GENERATED}");
-    let [obj, mtl] = obj_and_mtl("test/slab", "slab", &header, &parts, MtlNote::Plain);
+    let [obj, mtl] = obj_and_mtl("test/slab", "slab.obj", &header, &parts, MtlNote::Plain);
     vec![
         GenFile::text("test/slab/scene.toml", scene_toml(triangle_count(&parts))),
         obj,

@@ -92,7 +92,7 @@ pub fn files() -> Vec<GenFile> {
     );
     let [obj, mtl] = obj_and_mtl(
         "test/slab-edge-lit",
-        "slab-edge-lit",
+        "slab-edge-lit.obj",
         &header,
         &parts,
         MtlNote::Plain,

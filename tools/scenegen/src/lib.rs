@@ -429,15 +429,8 @@ pub fn tag_colour(tag: &str) -> [f64; 3] {
 pub fn write_mtl(header: &str, tags: &[&str]) -> String {
     let mut s = hash_lines(header);
     for tag in tags {
-        let c = tag_colour(tag);
-        writeln!(
-            s,
-            "\nnewmtl {tag}\nKd {} {} {}",
-            num(c[0]),
-            num(c[1]),
-            num(c[2])
-        )
-        .unwrap();
+        let rgb = tag_colour(tag).map(num).join(" ");
+        writeln!(s, "\nnewmtl {tag}\nKd {rgb}").unwrap();
         if tag.starts_with("lgp") {
             writeln!(s, "d 0.4").unwrap();
         }
@@ -548,13 +541,10 @@ pub fn write_gltf(
     let materials: Vec<String> = tags
         .iter()
         .map(|t| {
-            let c = tag_colour(t);
+            let rgb = tag_colour(t).map(num).join(", ");
             let opaque = !t.starts_with("lgp");
             format!(
-                "{{\"name\": \"{t}\", \"doubleSided\": {opaque}, \"pbrMetallicRoughness\": {{\"baseColorFactor\": [{}, {}, {}, 1.0], \"metallicFactor\": 0.0}}}}",
-                num(c[0]),
-                num(c[1]),
-                num(c[2])
+                "{{\"name\": \"{t}\", \"doubleSided\": {opaque}, \"pbrMetallicRoughness\": {{\"baseColorFactor\": [{rgb}, 1.0], \"metallicFactor\": 0.0}}}}"
             )
         })
         .collect();

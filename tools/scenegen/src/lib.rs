@@ -583,24 +583,6 @@ pub fn comment(text: &str) -> String {
         .collect()
 }
 
-/// The body of every bundled CCFL (a `[[sources]]` line with its comment).
-pub const CCFL_BODY: &str =
-    "# The tube's phosphor coat as a diffuse (Lambertian) reflector of albedo 0.5: a
-# modelling assumption, not a measurement. Backlight models commonly take 0.3 to 0.6;
-# no published measured value was found. The README (\"Lamp bodies\") gives the
-# efficiency for 0.3, 0.5 and 0.9. Left out: light that enters the tube and crosses it.
-body = { model = \"lambert\", albedo = 0.5 }
-";
-
-/// The body of every bundled LED (a `[[sources]]` line with its comment).
-pub const LED_BODY: &str =
-    "# The package front (phosphor-in-silicone window over the die in a white cup) as a
-# diffuse reflector of albedo 0.8: an assumption below the white cup's 0.95 (Panasonic
-# Full Bright CE6000/CV1800 LED reflector compounds, initial reflectance 95 %, EDN Japan,
-# 2 March 2012) for the darker die and phosphor it surrounds. The back absorbs.
-body = { model = \"lambert\", albedo = 0.8 }
-";
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,6 +18,7 @@
 //! radius_mm = 1.0
 //! length_mm = 59.0
 //! power_w = 1.0
+//! # ... (CCFL_BODY: where the albedo comes from)
 //! body = { model = "lambert", albedo = 0.5 }
 //!
 //! [detector]
@@ -34,10 +35,8 @@
 //! max_bounces = 100000
 //! ```
 
-use crate::{
-    CCFL_BODY, GenFile, LED_BODY, ObjTags, P3, Part, arr, comment, num, tags_of, write_mtl,
-    write_obj,
-};
+use crate::shapes::LGP_TAGS;
+use crate::{GenFile, ObjTags, P3, Part, arr, comment, num, tags_of, write_mtl, write_obj};
 
 /// A scene file: `header` as `#` comments, then `tables`, each after a blank line.
 pub fn scene_file(header: &str, tables: &[String]) -> String {
@@ -110,10 +109,10 @@ pub fn rough_dielectric(tag: &str, inside: &str, roughness: f64) -> String {
     )
 }
 
-/// The three smooth faces of a dot-free light guide of medium `inside`, in the order
-/// front, back, edge.
+/// The three smooth faces of a dot-free light guide of medium `inside`, in the order of
+/// [`LGP_TAGS`]: front, back, edge.
 pub fn bare_guide_faces(inside: &str) -> [String; 3] {
-    ["lgp_front", "lgp_back", "lgp_edge"].map(|tag| dielectric(tag, inside))
+    LGP_TAGS.map(|tag| dielectric(tag, inside))
 }
 
 /// The faces of a light guide with printed dots on its back, in the order front, edge
@@ -157,8 +156,9 @@ pub fn absorber(tag: &str) -> String {
     format!("[surfaces.{tag}]\nmodel = \"absorber\"\n")
 }
 
-/// Printed ink dots on a guide's face (`model = "dots"`), the pattern starting at the
-/// world origin (every bundled guide's corner).
+/// Printed ink dots on a guide's face (`model = "dots"`, src/optics/dots.rs), the pattern
+/// starting at the world origin (every bundled guide's lamp-edge corner), the dots at
+/// their cell centres.
 #[derive(Clone, Copy, Debug)]
 pub struct Dots<'a> {
     /// The guide's medium.
@@ -179,8 +179,8 @@ pub struct Dots<'a> {
     /// Whether the polynomial's variable is the position over `length` (`x_unit =
     /// "normalized"`) rather than millimetres (the default).
     pub normalized: bool,
-    /// Whether the pattern is mirrored about the middle of `length` (written only when
-    /// set).
+    /// Whether x is measured from the nearer end of `length` (lamps on both edges);
+    /// written only when set.
     pub mirror: Option<bool>,
 }
 
@@ -212,6 +212,24 @@ impl Dots<'_> {
 
 // ---------------------------------------------------------------------------------------
 // Sources, detector
+
+/// The body of every bundled CCFL (a `[[sources]]` line with its comment).
+pub const CCFL_BODY: &str =
+    "# The tube's phosphor coat as a diffuse (Lambertian) reflector of albedo 0.5: a
+# modelling assumption, not a measurement. Backlight models commonly take 0.3 to 0.6;
+# no published measured value was found. The README (\"Lamp bodies\") gives the
+# efficiency for 0.3, 0.5 and 0.9. Left out: light that enters the tube and crosses it.
+body = { model = \"lambert\", albedo = 0.5 }
+";
+
+/// The body of every bundled LED (a `[[sources]]` line with its comment).
+pub const LED_BODY: &str =
+    "# The package front (phosphor-in-silicone window over the die in a white cup) as a
+# diffuse reflector of albedo 0.8: an assumption below the white cup's 0.95 (Panasonic
+# Full Bright CE6000/CV1800 LED reflector compounds, initial reflectance 95 %, EDN Japan,
+# 2 March 2012) for the darker die and phosphor it surrounds. The back absorbs.
+body = { model = \"lambert\", albedo = 0.8 }
+";
 
 /// A row of identical sources (a source's `array` entry).
 #[derive(Clone, Copy, Debug)]
@@ -450,4 +468,64 @@ pub fn obj_and_mtl(
             write_mtl(&mtl_header, &tags_of(parts)),
         ),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes::guide_box;
+
+    #[test]
+    fn tables_follow_the_header_after_one_blank_line_each() {
+        let s = scene_file("title\n\nmore", &[preamble("x", "y"), trace_table(10, 5)]);
+        assert_eq!(
+            s,
+            "# title\n#\n# more\n\nversion = 1\nname = \"x\"\ndescription = \"y\"\n\n\
+             [trace]\nphotons = 10\nseed = 1\nmax_bounces = 5\n"
+        );
+    }
+
+    #[test]
+    fn optional_source_keys_are_written_only_when_set() {
+        let bare = Led {
+            body: false,
+            ..Led::facing_x("led", [0.0; 3], [1.0, 0.5])
+        }
+        .toml();
+        for key in ["lumens", "intensity_file", "cos_exponent", "medium", "body"] {
+            assert!(!bare.contains(key), "{key} in {bare}");
+        }
+        let full = Ccfl {
+            lumens: Some(300.0),
+            row: Some(Row {
+                count: 3,
+                pitch: 10.0,
+                direction: [1.0, 0.0, 0.0],
+            }),
+            ..Ccfl::new("lamp", [0.0; 3], 1.0, 20.0)
+        }
+        .toml();
+        let at = |k: &str| full.find(k).unwrap_or_else(|| panic!("{k} missing"));
+        assert!(at("power_w") < at("lumens") && at("lumens") < at("array"));
+        assert!(at("array") < at("body = "));
+    }
+
+    #[test]
+    fn the_obj_names_its_mtl_and_the_mtl_lists_its_tags() {
+        let parts = [guide_box("guide", [1.0, 1.0, 1.0])];
+        let [obj, mtl] = obj_and_mtl("f", "g.obj", "head", &parts, MtlNote::DisplayOnly);
+        assert_eq!(
+            (obj.path.as_str(), mtl.path.as_str()),
+            ("f/g.obj", "f/g.mtl")
+        );
+        let (obj, mtl) = (
+            String::from_utf8(obj.bytes).unwrap(),
+            String::from_utf8(mtl.bytes).unwrap(),
+        );
+        assert!(obj.starts_with("# head\nmtllib g.mtl\n"), "{obj}");
+        assert!(mtl.starts_with("# head\n# Display colours only"), "{mtl}");
+        for tag in LGP_TAGS {
+            assert!(mtl.contains(&format!("newmtl {tag}\n")), "{tag}");
+        }
+    }
 }

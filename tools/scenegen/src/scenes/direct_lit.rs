@@ -266,7 +266,7 @@ impl DirectLit {
         vec![bx, diffuser_plate()]
     }
 
-    pub(crate) fn scene_toml(&self, triangles: usize) -> String {
+    fn scene_toml(&self, triangles: usize) -> String {
         let reflector = match self.reflector {
             Reflector::Flat => "flat, at z = 0".to_string(),
             Reflector::Ridges { height } => format!(

@@ -8,6 +8,10 @@
 //!
 //! All vertex coordinates are rounded to 1e-6 mm before they are written, so the text of
 //! the files does not depend on the last bit of `sin`/`cos`.
+//!
+//! Each scene module (`scenes`) builds its files from shared pieces: [`shapes`] (solid
+//! boxes, sheets, the lamp box behind an edge) and [`templates`] (the scene file's TOML
+//! tables and the `.obj` + `.mtl` pair); this file holds the mesh type and the writers.
 
 use std::collections::BTreeMap;
 use std::f64::consts::PI;

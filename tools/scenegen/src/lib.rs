@@ -8,6 +8,10 @@
 //!
 //! All vertex coordinates are rounded to 1e-6 mm before they are written, so the text of
 //! the files does not depend on the last bit of `sin`/`cos`.
+//!
+//! Each scene module (`scenes`) builds its files from shared pieces: [`shapes`] (solid
+//! boxes, sheets, the lamp box behind an edge) and [`templates`] (the scene file's TOML
+//! tables and the `.obj` + `.mtl` pair); this file holds the mesh type and the writers.
 
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -16,6 +20,8 @@ use std::io;
 use std::path::Path;
 
 pub mod scenes;
+pub mod shapes;
+pub mod templates;
 
 /// A point (mm).
 pub type P3 = [f64; 3];
@@ -361,20 +367,22 @@ impl LampHolder {
 
 /// How an OBJ file names its tags.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ObjTags {
+pub enum ObjTags<'a> {
     /// `usemtl TAG` before each group (with a `mtllib` line naming this file).
-    Usemtl(&'static str),
+    Usemtl(&'a str),
     /// No materials: each part is one tag, named by an `o` line (even parts) or a `g`
     /// line (odd parts).
     ObjectNames,
 }
 
+/// Every line of `header` after `# ` (blank lines too, unlike [`comment`]).
+fn hash_lines(header: &str) -> String {
+    header.lines().map(|l| format!("# {l}\n")).collect()
+}
+
 /// An OBJ file of `parts`, each an `o` object; vertex indices are global and 1-based.
 pub fn write_obj(header: &str, parts: &[Part], tags: ObjTags) -> String {
-    let mut s = String::new();
-    for line in header.lines() {
-        writeln!(s, "# {line}").unwrap();
-    }
+    let mut s = hash_lines(header);
     if let ObjTags::Usemtl(mtl) = tags {
         writeln!(s, "mtllib {mtl}").unwrap();
     }
@@ -423,20 +431,10 @@ pub fn tag_colour(tag: &str) -> [f64; 3] {
 
 /// A `.mtl` file with one display material per tag.
 pub fn write_mtl(header: &str, tags: &[&str]) -> String {
-    let mut s = String::new();
-    for line in header.lines() {
-        writeln!(s, "# {line}").unwrap();
-    }
+    let mut s = hash_lines(header);
     for tag in tags {
-        let c = tag_colour(tag);
-        writeln!(
-            s,
-            "\nnewmtl {tag}\nKd {} {} {}",
-            num(c[0]),
-            num(c[1]),
-            num(c[2])
-        )
-        .unwrap();
+        let rgb = tag_colour(tag).map(num).join(" ");
+        writeln!(s, "\nnewmtl {tag}\nKd {rgb}").unwrap();
         if tag.starts_with("lgp") {
             writeln!(s, "d 0.4").unwrap();
         }
@@ -455,6 +453,11 @@ pub fn tags_of(parts: &[Part]) -> Vec<&str> {
         }
     }
     tags
+}
+
+/// Number of triangles of all `parts`.
+pub fn triangle_count(parts: &[Part]) -> usize {
+    parts.iter().map(Part::triangle_count).sum()
 }
 
 /// World millimetres, z up, to glTF's metres, y up.
@@ -542,13 +545,10 @@ pub fn write_gltf(
     let materials: Vec<String> = tags
         .iter()
         .map(|t| {
-            let c = tag_colour(t);
+            let rgb = tag_colour(t).map(num).join(", ");
             let opaque = !t.starts_with("lgp");
             format!(
-                "{{\"name\": \"{t}\", \"doubleSided\": {opaque}, \"pbrMetallicRoughness\": {{\"baseColorFactor\": [{}, {}, {}, 1.0], \"metallicFactor\": 0.0}}}}",
-                num(c[0]),
-                num(c[1]),
-                num(c[2])
+                "{{\"name\": \"{t}\", \"doubleSided\": {opaque}, \"pbrMetallicRoughness\": {{\"baseColorFactor\": [{rgb}, 1.0], \"metallicFactor\": 0.0}}}}"
             )
         })
         .collect();
@@ -586,24 +586,6 @@ pub fn comment(text: &str) -> String {
         })
         .collect()
 }
-
-/// The body of every bundled CCFL (a `[[sources]]` line with its comment).
-pub const CCFL_BODY: &str =
-    "# The tube's phosphor coat as a diffuse (Lambertian) reflector of albedo 0.5: a
-# modelling assumption, not a measurement. Backlight models commonly take 0.3 to 0.6;
-# no published measured value was found. The README (\"Lamp bodies\") gives the
-# efficiency for 0.3, 0.5 and 0.9. Left out: light that enters the tube and crosses it.
-body = { model = \"lambert\", albedo = 0.5 }
-";
-
-/// The body of every bundled LED (a `[[sources]]` line with its comment).
-pub const LED_BODY: &str =
-    "# The package front (phosphor-in-silicone window over the die in a white cup) as a
-# diffuse reflector of albedo 0.8: an assumption below the white cup's 0.95 (Panasonic
-# Full Bright CE6000/CV1800 LED reflector compounds, initial reflectance 95 %, EDN Japan,
-# 2 March 2012) for the darker die and phosphor it surrounds. The back absorbs.
-body = { model = \"lambert\", albedo = 0.8 }
-";
 
 #[cfg(test)]
 mod tests {

@@ -4,10 +4,14 @@
 //! The films are in their own geometry file, so a test can drop them to measure the
 //! on-axis gain they give.
 
-use super::{GENERATED, trace_table};
+use super::GENERATED;
+use crate::shapes::{Facing, guide_box, lamp_box, sheet_up, solid_box};
+use crate::templates::{
+    Detector, Dots, Led, dielectric, dotted_guide_faces, geometry, lambert, medium, mirror,
+    preamble, rough_dielectric, scene_file, trace_table,
+};
 use crate::{
-    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+    GenFile, ObjTags, P3, Part, arr, dim, dims, num, tags_of, triangle_count, write_mtl, write_obj,
 };
 
 /// Light guide size (x, y, z) (mm); it spans 0..GUIDE, lit through its x = 0 edge.
@@ -47,53 +51,31 @@ pub fn led() -> P3 {
 /// Guide, reflector sheet, lamp housing and diffuser.
 pub fn stack_parts() -> Vec<Part> {
     let [gx, gy, gz] = GUIDE;
-    let mut guide = Part::new("guide");
-    hexahedron(
-        &mut guide,
-        &box_corners([0.0; 3], GUIDE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
-    let mut sheet = Part::new("reflector_sheet");
-    let z = -SHEET_GAP;
-    sheet.quad(
-        "reflector_sheet",
-        [0.0, 0.0, z],
-        [gx, 0.0, z],
-        [gx, gy, z],
-        [0.0, gy, z],
-    );
-    // Five mirror walls round the LED, open towards the guide's x = 0 edge.
-    let mut housing = Part::new("lamp_reflector");
-    let (d, t) = (-HOUSING, "lamp_reflector");
-    housing.quad(t, [d, 0.0, 0.0], [d, gy, 0.0], [d, gy, gz], [d, 0.0, gz]);
-    housing.quad(
-        t,
-        [d, 0.0, 0.0],
-        [0.0, 0.0, 0.0],
-        [0.0, gy, 0.0],
-        [d, gy, 0.0],
-    );
-    housing.quad(t, [d, 0.0, gz], [d, gy, gz], [0.0, gy, gz], [0.0, 0.0, gz]);
-    housing.quad(
-        t,
-        [d, 0.0, 0.0],
-        [d, 0.0, gz],
-        [0.0, 0.0, gz],
-        [0.0, 0.0, 0.0],
-    );
-    housing.quad(t, [d, gy, 0.0], [0.0, gy, 0.0], [0.0, gy, gz], [d, gy, gz]);
-    let mut diffuser = Part::new("diffuser");
     let [z0, th] = DIFFUSER;
-    hexahedron(
-        &mut diffuser,
-        &box_corners([0.0, 0.0, z0], [gx, gy, z0 + th]),
-        "diffuser_top",
-        "diffuser_back",
-        "diffuser_edge",
-    );
-    vec![guide, sheet, housing, diffuser]
+    vec![
+        guide_box("guide", GUIDE),
+        sheet_up(
+            "reflector_sheet",
+            "reflector_sheet",
+            [0.0, 0.0],
+            [gx, gy],
+            -SHEET_GAP,
+        ),
+        // Five mirror walls round the LED, open towards the guide's x = 0 edge.
+        lamp_box(
+            "lamp_reflector",
+            "lamp_reflector",
+            HOUSING,
+            [gy, gz],
+            Facing::In,
+        ),
+        solid_box(
+            "diffuser",
+            [0.0, 0.0, z0],
+            [gx, gy, z0 + th],
+            ["diffuser_top", "diffuser_back", "diffuser_edge"],
+        ),
+    ]
 }
 
 /// The two prism films.
@@ -102,49 +84,43 @@ pub fn film_parts() -> Vec<Part> {
     (1..=2)
         .map(|i| {
             let z0 = BEF_Z[i - 1];
-            let mut p = Part::new(&format!("bef{i}"));
-            hexahedron(
-                &mut p,
-                &box_corners([0.0, 0.0, z0], [gx, gy, z0 + BEF_T]),
-                &format!("bef{i}_top"),
-                &format!("bef{i}_back"),
-                &format!("bef{i}_edge"),
-            );
-            p
+            let tags = ["top", "back", "edge"].map(|face| format!("bef{i}_{face}"));
+            let [top, back, edge] = tags.each_ref().map(String::as_str);
+            solid_box(
+                &format!("bef{i}"),
+                [0.0, 0.0, z0],
+                [gx, gy, z0 + BEF_T],
+                [top, back, edge],
+            )
         })
         .collect()
 }
 
-fn film_surfaces() -> String {
-    let mut s = String::new();
+/// The prism films' surfaces: bef1's prisms run along y, bef2's along x.
+fn film_surfaces() -> Vec<String> {
+    let mut tables = Vec::new();
     for (i, axis) in [(1, [1.0, 0.0, 0.0]), (2, [0.0, 1.0, 0.0])] {
         let z0 = BEF_Z[i - 1];
-        s += &format!(
-            "
-[surfaces.bef{i}_top]
+        let pet = format!("pet_bef{i}");
+        tables.push(format!(
+            "[surfaces.bef{i}_top]
 model = \"grooves\"
-inside = \"pet_bef{i}\"
+inside = \"{pet}\"
 relief = \"raised\"
 apex_deg = {apex}
 pitch_mm = {p}
 origin = {o}
 axis = {a}
-
-[surfaces.bef{i}_back]
-model = \"dielectric\"
-inside = \"pet_bef{i}\"
-
-[surfaces.bef{i}_edge]
-model = \"dielectric\"
-inside = \"pet_bef{i}\"
 ",
             apex = num(PRISM[1]),
             p = num(PRISM[0]),
             o = arr(&[0.0, 0.0, z0 + BEF_T]),
             a = arr(&axis),
-        );
+        ));
+        tables.push(dielectric(&format!("bef{i}_back"), &pet));
+        tables.push(dielectric(&format!("bef{i}_edge"), &pet));
     }
-    s
+    tables
 }
 
 fn scene_toml(triangles: usize) -> String {
@@ -191,117 +167,47 @@ Geometry: bef-stack.obj and bef-films.obj (usemtl names are tags), {triangles} t
         ph = num(height),
         gap = num(DETECTOR_Z - BEF_Z[1] - BEF_T - height),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"bef-stack\"
-description = \"Edge-lit guide {gx} x {gy} x {gz} mm with reflector, diffuser sheet and two crossed 90 deg prism films\"
-
-[[geometry]]
-file = \"bef-stack.obj\"
-
-[[geometry]]
-file = \"bef-films.obj\"
-
-[media.pmma]
-n = {npmma}
-absorption_per_mm = 0.0
-
-[media.pet_diffuser]
-n = {npet}
-absorption_per_mm = 0.0
-
-[media.pet_bef1]
-n = {npet}
-absorption_per_mm = 0.0
-
-[media.pet_bef2]
-n = {npet}
-absorption_per_mm = 0.0
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = 0.92
-lattice = \"hex\"
-pitch_mm = {dp}
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {gxn}
-density = {dd}
-x_unit = \"normalized\"
-
-[surfaces.reflector_sheet]
-model = \"lambert\"
-albedo = 0.95
-
-[surfaces.lamp_reflector]
-model = \"mirror\"
-reflectance = 0.95
-
-[surfaces.diffuser_top]
-model = \"diffuser\"
-inside = \"pet_diffuser\"
-roughness = {rough}
-
-[surfaces.diffuser_back]
-model = \"dielectric\"
-inside = \"pet_diffuser\"
-
-[surfaces.diffuser_edge]
-model = \"dielectric\"
-inside = \"pet_diffuser\"
-{films}
-[[sources]]
-type = \"led\"
-name = \"led_bar\"
-center = {c}
-normal = [1.0, 0.0, 0.0]
-u = [0.0, 1.0, 0.0]
-width_mm = {lw}
-height_mm = {lh}
-power_w = 1.0
-{LED_BODY}
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [20, 15]
-angular_bins = [18, 36]
-
-{trace}",
-        npmma = num(N_PMMA),
-        npet = num(N_PET),
-        dp = num(DOT_PITCH),
-        gxn = num(gx),
-        dd = arr(&DOT_DENSITY),
-        rough = num(ROUGHNESS),
-        films = film_surfaces(),
-        c = arr(&led()),
-        lw = num(LED[0]),
-        lh = num(LED[1]),
-        o = arr(&[0.0, 0.0, DETECTOR_Z]),
-        ds = arr(&[gx, gy]),
-        trace = trace_table(200_000, 100_000),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: 0.92,
+        lattice: "hex",
+        pitch: DOT_PITCH,
+        axis: [1.0, 0.0, 0.0],
+        length: gx,
+        density: &DOT_DENSITY,
+        normalized: true,
+        mirror: None,
+    };
+    let description = format!(
+        "Edge-lit guide {gx} x {gy} x {gz} mm with reflector, diffuser sheet and two crossed 90 deg prism films"
     );
-    s
+    let mut tables = vec![
+        preamble("bef-stack", &description),
+        geometry("bef-stack.obj"),
+        geometry("bef-films.obj"),
+    ];
+    tables.push(medium("pmma", N_PMMA, 0.0, None));
+    for pet in ["pet_diffuser", "pet_bef1", "pet_bef2"] {
+        tables.push(medium(pet, N_PET, 0.0, None));
+    }
+    tables.extend(dotted_guide_faces(&dots));
+    tables.push(lambert("reflector_sheet", 0.95));
+    tables.push(mirror("lamp_reflector", 0.95));
+    tables.push(rough_dielectric("diffuser_top", "pet_diffuser", ROUGHNESS));
+    tables.push(dielectric("diffuser_back", "pet_diffuser"));
+    tables.push(dielectric("diffuser_edge", "pet_diffuser"));
+    tables.extend(film_surfaces());
+    tables.push(Led::facing_x("led_bar", led(), LED).toml());
+    tables.push(Detector::new([0.0, 0.0, DETECTOR_Z], [gx, gy], [20, 15]).toml());
+    tables.push(trace_table(200_000, 100_000));
+    scene_file(&header, &tables)
 }
 
 /// `bef-stack/scene.toml`, `bef-stack.obj`, `bef-films.obj` and `bef-stack.mtl`.
 pub fn files() -> Vec<GenFile> {
     let stack = stack_parts();
     let films = film_parts();
-    let triangles: usize = stack.iter().chain(&films).map(Part::triangle_count).sum();
+    let triangles = triangle_count(&stack) + triangle_count(&films);
     let header = format!(
         "bef-stack: edge-lit backlight with diffuser and crossed prism films (see scene.toml). Units mm.\n{GENERATED}"
     );

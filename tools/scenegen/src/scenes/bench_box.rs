@@ -4,11 +4,13 @@
 //! analytic planes (`src/bench/reference.rs` refuses any scene not of this shape), and
 //! still a backlight whose light has to be extracted by the dots.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{guide_box, sheet_up};
+use crate::templates::{
+    Detector, Dots, Led, MtlNote, dotted_guide_faces, geometry, lambert, medium, obj_and_mtl,
+    preamble, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, dim, triangle_count};
 
 /// Guide size (x along the light, y along the lit edge, z thickness) (mm); the guide spans
 /// 0..SIZE.
@@ -38,24 +40,16 @@ pub const INK_ALBEDO: f64 = 0.9;
 /// The guide and the reflector sheet under it (from under the strip to the far edge).
 pub fn parts() -> Vec<Part> {
     let [sx, sy, _] = SIZE;
-    let mut guide = Part::new("guide");
-    hexahedron(
-        &mut guide,
-        &box_corners([0.0; 3], SIZE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
-    let mut sheet = Part::new("sheet");
-    let (x0, z) = (-STRIP_GAP, -SHEET_GAP);
-    sheet.quad(
-        "reflector_sheet",
-        [x0, 0.0, z],
-        [sx, 0.0, z],
-        [sx, sy, z],
-        [x0, sy, z],
-    );
-    vec![guide, sheet]
+    vec![
+        guide_box("guide", SIZE),
+        sheet_up(
+            "sheet",
+            "reflector_sheet",
+            [-STRIP_GAP, 0.0],
+            [sx, sy],
+            -SHEET_GAP,
+        ),
+    ]
 }
 
 fn scene_toml(triangles: usize) -> String {
@@ -101,96 +95,68 @@ Geometry: bench-box.obj (tags are its usemtl names), {triangles} triangles.
         zs = dim(-SHEET_GAP),
         zd = dim(sz + DETECTOR_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"bench-box\"
-description = \"Edge-lit {h} x {w} x {t} mm PMMA box guide, Lambertian edge strip, graded square dots, white sheet: blutrace bench's reference scene\"
-
-[[geometry]]
-file = \"bench-box.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = {INK_ALBEDO}
-lattice = \"square\"
-pitch_mm = {DOT_PITCH}
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {len}
-density = {density}
-x_unit = \"normalized\"
-
-[surfaces.reflector_sheet]
-model = \"lambert\"
-albedo = {SHEET_ALBEDO}
-
-[[sources]]
-type = \"led\"
-name = \"edge_strip\"
-center = {center}
-normal = [1.0, 0.0, 0.0]
-u = [0.0, 1.0, 0.0]
-width_mm = {w}
-height_mm = {t}
-power_w = {power}
-cos_exponent = 1.0
-{LED_BODY}
-[detector]
-origin = {origin}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {size}
-bins = [{bx}, {by}]
-angular_bins = [18, 36]
-
-{trace}",
-        w = dim(sy),
-        h = dim(sx),
-        t = dim(sz),
-        n = num(N_PMMA),
-        len = num(sx),
-        density = arr(&DOT_DENSITY),
-        center = arr(&[-STRIP_GAP, 0.5 * sy, 0.5 * sz]),
-        power = num(STRIP_POWER_W),
-        origin = arr(&[0.0, 0.0, sz + DETECTOR_GAP]),
-        size = arr(&[sx, sy]),
-        bx = sx as usize,
-        by = sy as usize,
-        trace = trace_table(400_000, 100_000),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: INK_ALBEDO,
+        lattice: "square",
+        pitch: DOT_PITCH,
+        axis: [1.0, 0.0, 0.0],
+        length: sx,
+        density: &DOT_DENSITY,
+        normalized: true,
+        mirror: None,
+    };
+    let [front, edge, back] = dotted_guide_faces(&dots);
+    let strip = Led {
+        cos_exponent: Some(1.0),
+        power_w: STRIP_POWER_W,
+        // Whole millimetres without `.0` (`80`, not `80.0`), as the scene has always read.
+        size_format: dim,
+        ..Led::facing_x("edge_strip", [-STRIP_GAP, 0.5 * sy, 0.5 * sz], [sy, sz])
+    };
+    let description = format!(
+        "Edge-lit {} x {} x {} mm PMMA box guide, Lambertian edge strip, graded square dots, white sheet: blutrace bench's reference scene",
+        dim(sx),
+        dim(sy),
+        dim(sz)
     );
-    s
+    let detector = Detector::new(
+        [0.0, 0.0, sz + DETECTOR_GAP],
+        [sx, sy],
+        [sx as usize, sy as usize],
+    );
+    scene_file(
+        &header,
+        &[
+            preamble("bench-box", &description),
+            geometry("bench-box.obj"),
+            medium("pmma", N_PMMA, ABSORPTION, None),
+            front,
+            edge,
+            back,
+            lambert("reflector_sheet", SHEET_ALBEDO),
+            strip.toml(),
+            detector.toml(),
+            trace_table(400_000, 100_000),
+        ],
+    )
 }
 
 /// `bench-box/scene.toml`, `.obj` and `.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
     let header = format!("bench-box: box guide and sheet (see scene.toml). Units mm.\n{GENERATED}");
+    let [obj, mtl] = obj_and_mtl(
+        "bench-box",
+        "bench-box.obj",
+        &header,
+        &parts,
+        MtlNote::Plain,
+    );
     vec![
-        GenFile::text("bench-box/scene.toml", scene_toml(triangles)),
-        GenFile::text(
-            "bench-box/bench-box.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("bench-box.mtl")),
-        ),
-        GenFile::text(
-            "bench-box/bench-box.mtl",
-            write_mtl(&header, &tags_of(&parts)),
-        ),
+        GenFile::text("bench-box/scene.toml", scene_toml(triangle_count(&parts))),
+        obj,
+        mtl,
     ]
 }
 

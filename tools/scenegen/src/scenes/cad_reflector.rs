@@ -18,11 +18,13 @@
 //! The exported files are not generated here ([`EXPORTED`]); the constants below must
 //! match the Python script's.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{guide_box, sheet_up};
+use crate::templates::{
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
+    preamble, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, dim, num, triangle_count};
 
 /// Files below `scenes/` written by `tools/cad/export-reflector.sh`, not by scenegen.
 pub const EXPORTED: &[&str] = &[
@@ -79,39 +81,29 @@ pub fn lamp() -> P3 {
 
 /// Light guide and reflector sheet (the lamp reflector comes from the CAD files).
 pub fn parts() -> Vec<Part> {
-    let mut lgp = Part::new("lgp");
-    hexahedron(
-        &mut lgp,
-        &box_corners([0.0, 0.0, 0.0], [L, W, T]),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
-    let mut sheet = Part::new("reflector_sheet");
-    let (x0, z) = (-LIP_GAP, -SHEET_GAP);
-    sheet.quad(
-        "reflector_sheet",
-        [x0, 0.0, z],
-        [L, 0.0, z],
-        [L, W, z],
-        [x0, W, z],
-    );
-    vec![lgp, sheet]
+    vec![
+        guide_box("lgp", [L, W, T]),
+        sheet_up(
+            "reflector_sheet",
+            "reflector_sheet",
+            [-LIP_GAP, 0.0],
+            [L, W],
+            -SHEET_GAP,
+        ),
+    ]
 }
 
 fn scene_toml(obj: bool, triangles: usize) -> String {
-    let (which, file, scale) = if obj {
+    let (which, file) = if obj {
         (
             "the OBJ export (reflector.obj + .mtl, written in mm)",
             "reflector.obj",
-            "",
         )
     } else {
         (
             "the glTF export (reflector.gltf + .bin, Blender's defaults: metres and +y up, as \
              glTF specifies and blutrace reads glTF by default)",
             "reflector.gltf",
-            "",
         )
     };
     let other = if obj { "scene.toml" } else { "scene-obj.toml" };
@@ -151,111 +143,60 @@ Geometry: lgp.obj ({triangles} triangles) and {file}.
         x0 = dim(-LIP_GAP),
         zd = dim(T + DETECTOR_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"cad-reflector{suffix}\"
-description = \"Edge-lit {L} x {W} x {T} mm PMMA guide, one CCFL in a parabolic reflector exported from Blender ({fmt})\"
-
-[[geometry]]
-file = \"lgp.obj\"
-
-[[geometry]]
-file = \"{file}\"
-{scale}
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = {INK_ALBEDO}
-lattice = \"hex\"
-pitch_mm = {DOT_PITCH}
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {len}
-density = {density}
-x_unit = \"normalized\"
-
-[surfaces.lamp_reflector]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.8
-exponent = 100.0
-
-[surfaces.reflector_sheet]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.1
-exponent = 10.0
-
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {center}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {r}
-length_mm = {w}
-power_w = 1.0
-{CCFL_BODY}
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {size}
-bins = [80, 60]
-angular_bins = [18, 36]
-
-{trace}",
-        suffix = if obj { "-obj" } else { "" },
-        fmt = if obj { "OBJ" } else { "glTF" },
-        n = num(N_PMMA),
-        len = num(L),
-        density = arr(&DOT_DENSITY),
-        center = arr(&c),
-        r = num(LAMP_R),
-        w = num(W),
-        o = arr(&[0.0, 0.0, T + DETECTOR_GAP]),
-        size = arr(&[L, W]),
-        trace = trace_table(400_000, 100_000),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: INK_ALBEDO,
+        lattice: "hex",
+        pitch: DOT_PITCH,
+        axis: [1.0, 0.0, 0.0],
+        length: L,
+        density: &DOT_DENSITY,
+        normalized: true,
+        mirror: None,
+    };
+    let [front, edge, back] = dotted_guide_faces(&dots);
+    let (suffix, fmt) = if obj { ("-obj", "OBJ") } else { ("", "glTF") };
+    let description = format!(
+        "Edge-lit {L} x {W} x {T} mm PMMA guide, one CCFL in a parabolic reflector exported from Blender ({fmt})"
     );
-    s
+    scene_file(
+        &header,
+        &[
+            preamble(&format!("cad-reflector{suffix}"), &description),
+            geometry("lgp.obj"),
+            geometry(file),
+            medium("pmma", N_PMMA, ABSORPTION, None),
+            front,
+            edge,
+            back,
+            phong("lamp_reflector", 0.95, 0.8, 100.0),
+            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            Ccfl::new("lamp", c, LAMP_R, W).toml(),
+            Detector::new([0.0, 0.0, T + DETECTOR_GAP], [L, W], [80, 60]).toml(),
+            trace_table(400_000, 100_000),
+        ],
+    )
 }
 
 /// `cad-reflector/scene.toml`, `scene-obj.toml`, `lgp.obj` and `lgp.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
+    let triangles = triangle_count(&parts);
     let header = format!(
         "cad-reflector: light guide and reflector sheet (see scene.toml). Units mm.\n{GENERATED}"
+    );
+    let [obj, mtl] = obj_and_mtl(
+        "cad-reflector",
+        "lgp.obj",
+        &header,
+        &parts,
+        MtlNote::DisplayOnly,
     );
     vec![
         GenFile::text("cad-reflector/scene.toml", scene_toml(false, triangles)),
         GenFile::text("cad-reflector/scene-obj.toml", scene_toml(true, triangles)),
-        GenFile::text(
-            "cad-reflector/lgp.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("lgp.mtl")),
-        ),
-        GenFile::text(
-            "cad-reflector/lgp.mtl",
-            write_mtl(
-                &format!(
-                    "{header}\nDisplay colours only: blutrace reads the usemtl names as tags."
-                ),
-                &tags_of(&parts),
-            ),
-        ),
+        obj,
+        mtl,
     ]
 }
 

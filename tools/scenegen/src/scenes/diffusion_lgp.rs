@@ -4,11 +4,13 @@
 //! under the guide. Three bead loads share the geometry: `scene.toml` (the middle one),
 //! `scene-light.toml` and `scene-heavy.toml`.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{Facing, guide_box, lamp_box, sheet_up};
+use crate::templates::{
+    Beads, Ccfl, Detector, MtlNote, bare_guide_faces, geometry, lambert, medium, obj_and_mtl,
+    preamble, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, dim, dims, num, triangle_count};
 
 /// Guide size (x along the light, y across, z thickness) (mm); it spans 0..SIZE.
 pub const SIZE: P3 = [200.0, 120.0, 4.0];
@@ -51,42 +53,8 @@ pub fn lamp() -> P3 {
 /// reflector sheet and white tape along the other three edges.
 pub fn parts() -> Vec<Part> {
     let [sx, sy, sz] = SIZE;
-    let mut guide = Part::new("guide");
-    hexahedron(
-        &mut guide,
-        &box_corners([0.0; 3], SIZE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
-    let mut cavity = Part::new("cavity");
-    let (d, t) = (-CAVITY, "lamp_cavity");
-    cavity.quad(t, [d, 0.0, 0.0], [d, 0.0, sz], [d, sy, sz], [d, sy, 0.0]);
-    cavity.quad(
-        t,
-        [d, 0.0, 0.0],
-        [d, sy, 0.0],
-        [0.0, sy, 0.0],
-        [0.0, 0.0, 0.0],
-    );
-    cavity.quad(t, [d, 0.0, sz], [0.0, 0.0, sz], [0.0, sy, sz], [d, sy, sz]);
-    cavity.quad(
-        t,
-        [d, 0.0, 0.0],
-        [0.0, 0.0, 0.0],
-        [0.0, 0.0, sz],
-        [d, 0.0, sz],
-    );
-    cavity.quad(t, [d, sy, 0.0], [d, sy, sz], [0.0, sy, sz], [0.0, sy, 0.0]);
-    let mut sheet = Part::new("sheet");
-    let z = -SHEET_GAP;
-    sheet.quad(
-        "reflector_sheet",
-        [0.0, 0.0, z],
-        [sx, 0.0, z],
-        [sx, sy, z],
-        [0.0, sy, z],
-    );
+    let cavity = lamp_box("cavity", "lamp_cavity", CAVITY, [sy, sz], Facing::Out);
+    let sheet = sheet_up("sheet", "reflector_sheet", [0.0, 0.0], [sx, sy], -SHEET_GAP);
     // White tape on the three edges away from the lamp, a sheet gap off each.
     let mut tape = Part::new("tape");
     let (g, t) = (SHEET_GAP, "edge_tape");
@@ -111,7 +79,7 @@ pub fn parts() -> Vec<Part> {
         [sx, sy + g, sz],
         [0.0, sy + g, sz],
     );
-    vec![guide, cavity, sheet, tape]
+    vec![guide_box("guide", SIZE), cavity, sheet, tape]
 }
 
 fn scene_toml(load: &str, fv: f64, triangles: usize) -> String {
@@ -155,84 +123,40 @@ Geometry: diffusion-lgp.obj (usemtl names are tags), {triangles} triangles.
         bx = BINS[0],
         by = BINS[1],
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"diffusion-lgp-{load}\"
-description = \"Edge-lit diffusion light guide {sx} x {sy} x {sz} mm, beads at {fvs} by volume, no dots\"
-
-[[geometry]]
-file = \"diffusion-lgp.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-particles = {{ radius_um = {r}, n = {nb}, volume_fraction = {fvs}, wavelength_nm = 550.0 }}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lamp_cavity]
-model = \"lambert\"
-albedo = {w}
-
-[surfaces.reflector_sheet]
-model = \"lambert\"
-albedo = {w}
-
-[surfaces.edge_tape]
-model = \"lambert\"
-albedo = {w}
-
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {c}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {lr}
-length_mm = {l}
-power_w = 1.0
-{CCFL_BODY}
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [{bx}, {by}]
-angular_bins = [18, 36]
-
-{trace}",
-        n = num(N_PMMA),
-        r = num(BEAD_RADIUS_UM),
-        nb = num(BEAD_N),
-        fvs = num(fv),
-        w = num(WHITE_ALBEDO),
-        c = arr(&lamp()),
-        lr = num(LAMP_R),
-        l = num(sy - 1.0),
-        o = arr(&[0.0, 0.0, sz + DETECTOR_GAP]),
-        ds = arr(&[sx, sy]),
-        bx = BINS[0],
-        by = BINS[1],
-        trace = trace_table(400_000, 100_000),
+    let beads = Beads {
+        radius_um: BEAD_RADIUS_UM,
+        n: BEAD_N,
+        volume_fraction: fv,
+    };
+    let [front, back, edge] = bare_guide_faces("pmma");
+    let description = format!(
+        "Edge-lit diffusion light guide {sx} x {sy} x {sz} mm, beads at {} by volume, no dots",
+        num(fv)
     );
-    s
+    let detector = Detector::new([0.0, 0.0, sz + DETECTOR_GAP], [sx, sy], BINS);
+    scene_file(
+        &header,
+        &[
+            preamble(&format!("diffusion-lgp-{load}"), &description),
+            geometry("diffusion-lgp.obj"),
+            medium("pmma", N_PMMA, ABSORPTION, Some(&beads)),
+            front,
+            back,
+            edge,
+            lambert("lamp_cavity", WHITE_ALBEDO),
+            lambert("reflector_sheet", WHITE_ALBEDO),
+            lambert("edge_tape", WHITE_ALBEDO),
+            Ccfl::new("lamp", lamp(), LAMP_R, sy - 1.0).toml(),
+            detector.toml(),
+            trace_table(400_000, 100_000),
+        ],
+    )
 }
 
 /// The three scene files, the `.obj` and the `.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
+    let triangles = triangle_count(&parts);
     let header = format!(
         "diffusion-lgp: edge-lit diffusion light guide (see scene.toml). Units mm.\n{GENERATED}"
     );
@@ -245,13 +169,12 @@ pub fn files() -> Vec<GenFile> {
             )
         })
         .collect();
-    files.push(GenFile::text(
-        "diffusion-lgp/diffusion-lgp.obj",
-        write_obj(&header, &parts, ObjTags::Usemtl("diffusion-lgp.mtl")),
-    ));
-    files.push(GenFile::text(
-        "diffusion-lgp/diffusion-lgp.mtl",
-        write_mtl(&header, &tags_of(&parts)),
+    files.extend(obj_and_mtl(
+        "diffusion-lgp",
+        "diffusion-lgp.obj",
+        &header,
+        &parts,
+        MtlNote::Plain,
     ));
     files
 }

@@ -12,11 +12,13 @@
 //! }
 //! ```
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num,
-    tags_of, write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::solid_box;
+use crate::templates::{
+    Beads, Ccfl, Detector, MtlNote, dielectric, geometry, lambert, medium, obj_and_mtl, preamble,
+    rough_dielectric, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, dim, num, triangle_count};
 
 /// Inner box length along x, across the lamps (mm).
 pub const BOX_X: f64 = 400.0;
@@ -50,10 +52,9 @@ pub const BEAD_N: f64 = 1.42;
 /// Bulk plate: the beads' volume fraction, a design choice: 1 % by volume is 1.1 % by
 /// weight at the beads' specific gravity (TSR9000: 1.32) in PC (1.20).
 pub const BEAD_VOLUME_FRACTION: f64 = 0.01;
-/// The geometry file's name in every variant's folder.
+/// The geometry file's name in every variant's folder (its display-material library is
+/// `direct-lit.mtl`).
 pub const OBJ: &str = "direct-lit.obj";
-/// Its display-material library.
-pub const MTL: &str = "direct-lit.mtl";
 
 /// The back reflector's shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -262,18 +263,10 @@ impl DirectLit {
             );
             bx.quad(t, [xa, y1, za], [xb, y1, zb], [xb, y1, top], [xa, y1, top]);
         }
-        let mut plate = Part::new("diffuser");
-        hexahedron(
-            &mut plate,
-            &box_corners([0.0, 0.0, DEPTH], [BOX_X, BOX_Y, DEPTH + PLATE_T]),
-            "diffuser_top",
-            "diffuser_back",
-            "diffuser_edge",
-        );
-        vec![bx, plate]
+        vec![bx, diffuser_plate()]
     }
 
-    pub(crate) fn scene_toml(&self, triangles: usize) -> String {
+    fn scene_toml(&self, triangles: usize) -> String {
         let reflector = match self.reflector {
             Reflector::Flat => "flat, at z = 0".to_string(),
             Reflector::Ridges { height } => format!(
@@ -318,91 +311,62 @@ Geometry: {obj} (tags are its usemtl names), {triangles} triangles.
             by = self.bins[1],
             obj = OBJ,
         );
-        let mut s = comment(&header);
-        s += &format!(
-            "
-version = 1
-name = \"{name}\"
-description = \"Direct-lit BLU: {n} CCFLs at {pitch} mm pitch in a {BOX_X} x {BOX_Y} x {DEPTH} mm white box behind a {PLATE_T} mm plate\"
-
-[[geometry]]
-file = \"{obj}\"
-
-[media.pc]
-n = {np}
-absorption_per_mm = {PLATE_ABSORPTION}{particles}
-
-[surfaces.box_reflector]
-model = \"lambert\"
-albedo = {WALL_ALBEDO}
-
-[surfaces.diffuser_top]
-{face}
-[surfaces.diffuser_back]
-{face}
-[surfaces.diffuser_edge]
-model = \"dielectric\"
-inside = \"pc\"
-",
-            name = self.name,
-            n = self.lamps,
-            pitch = dim(self.pitch),
-            obj = OBJ,
-            np = num(N_PLATE),
-            particles = match self.plate {
-                Plate::Bulk => format!(
-                    "\nparticles = {{ radius_um = {}, n = {}, volume_fraction = {}, wavelength_nm = 550.0 }}",
-                    num(BEAD_RADIUS_UM),
-                    num(BEAD_N),
-                    num(BEAD_VOLUME_FRACTION)
-                ),
-                Plate::Rough { .. } => String::new(),
-            },
-            face = match self.plate {
-                Plate::Bulk => "model = \"dielectric\"\ninside = \"pc\"\n".to_string(),
-                Plate::Rough { roughness } => format!(
-                    "model = \"diffuser\"\ninside = \"pc\"\nroughness = {}\n",
-                    num(roughness)
-                ),
-            },
+        let description = format!(
+            "Direct-lit BLU: {} CCFLs at {} mm pitch in a {BOX_X} x {BOX_Y} x {DEPTH} mm white box behind a {PLATE_T} mm plate",
+            self.lamps,
+            dim(self.pitch)
         );
+        let mut tables = vec![preamble(&self.name, &description), geometry(OBJ)];
+        tables.extend(self.plate_and_walls());
         for (i, c) in self.lamp_centres().iter().enumerate() {
-            s += &format!(
-                "
-[[sources]]
-type = \"ccfl\"
-name = \"lamp{}\"
-center = {}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {}
-length_mm = {}
-power_w = {}
-{CCFL_BODY}",
-                i + 1,
-                arr(c),
-                num(LAMP_R),
-                num(self.lamp_length()),
-                num(LAMP_POWER_W)
-            );
+            let name = format!("lamp{}", i + 1);
+            let lamp = Ccfl {
+                power_w: LAMP_POWER_W,
+                ..Ccfl::new(&name, *c, LAMP_R, self.lamp_length())
+            };
+            tables.push(lamp.toml());
         }
-        s += &format!(
-            "
-[detector]
-origin = {}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {}
-bins = [{}, {}]
-angular_bins = [18, 36]
+        tables.push(self.detector().toml());
+        tables.push(trace_table(self.photons, 100_000));
+        scene_file(&header, &tables)
+    }
 
-{}",
-            arr(&[0.0, 0.0, DEPTH + PLATE_T + DETECTOR_GAP]),
-            arr(&[BOX_X, BOX_Y]),
-            self.bins[0],
-            self.bins[1],
-            trace_table(self.photons, 100_000)
-        );
-        s
+    /// The plate's medium and the surfaces of the box and the plate.
+    pub(crate) fn plate_and_walls(&self) -> Vec<String> {
+        let (beads, top_and_back) = match self.plate {
+            Plate::Bulk => {
+                let beads = Beads {
+                    radius_um: BEAD_RADIUS_UM,
+                    n: BEAD_N,
+                    volume_fraction: BEAD_VOLUME_FRACTION,
+                };
+                (
+                    Some(beads),
+                    ["diffuser_top", "diffuser_back"].map(|t| dielectric(t, "pc")),
+                )
+            }
+            Plate::Rough { roughness } => (
+                None,
+                ["diffuser_top", "diffuser_back"].map(|t| rough_dielectric(t, "pc", roughness)),
+            ),
+        };
+        let [top, back] = top_and_back;
+        vec![
+            medium("pc", N_PLATE, PLATE_ABSORPTION, beads.as_ref()),
+            lambert("box_reflector", WALL_ALBEDO),
+            top,
+            back,
+            dielectric("diffuser_edge", "pc"),
+        ]
+    }
+
+    /// The detector, [`DETECTOR_GAP`] above the plate, covering it.
+    pub(crate) fn detector(&self) -> Detector {
+        Detector::new(
+            [0.0, 0.0, DEPTH + PLATE_T + DETECTOR_GAP],
+            [BOX_X, BOX_Y],
+            self.bins,
+        )
     }
 
     /// The plate's paragraph in the scene file's header.
@@ -442,25 +406,30 @@ angular_bins = [18, 36]
             panic!("{}: {e}", self.name);
         }
         let parts = self.parts();
-        let triangles = parts.iter().map(Part::triangle_count).sum();
         let header = format!(
             "{}: direct-lit backlight, {} lamps (see scene.toml). Units mm.\n{GENERATED}",
             self.name, self.lamps
         );
-        let mtl_header =
-            format!("{header}\nDisplay colours only: blutrace reads the usemtl names as tags.");
+        let [obj, mtl] = obj_and_mtl(folder, OBJ, &header, &parts, MtlNote::DisplayOnly);
         vec![
-            GenFile::text(&format!("{folder}/scene.toml"), self.scene_toml(triangles)),
             GenFile::text(
-                &format!("{folder}/{OBJ}"),
-                write_obj(&header, &parts, ObjTags::Usemtl(MTL)),
+                &format!("{folder}/scene.toml"),
+                self.scene_toml(triangle_count(&parts)),
             ),
-            GenFile::text(
-                &format!("{folder}/{MTL}"),
-                write_mtl(&mtl_header, &tags_of(&parts)),
-            ),
+            obj,
+            mtl,
         ]
     }
+}
+
+/// The diffuser plate resting on the box's walls.
+pub fn diffuser_plate() -> Part {
+    solid_box(
+        "diffuser",
+        [0.0, 0.0, DEPTH],
+        [BOX_X, BOX_Y, DEPTH + PLATE_T],
+        ["diffuser_top", "diffuser_back", "diffuser_edge"],
+    )
 }
 
 /// Distance from point `p` to segment `a b` in the xz plane.

@@ -5,39 +5,40 @@
 //! for `blutrace optimize --vary`. Only the diffuser plate is meshed. Same physics as
 //! `direct-lit` (a test traces both).
 
-use super::direct_lit::{BOX_X, BOX_Y, DEPTH, DirectLit, LAMP_POWER_W, LAMP_R, PLATE_T, Reflector};
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, ObjTags, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
+use super::GENERATED;
+use super::direct_lit::{
+    BOX_X, BOX_Y, DEPTH, DirectLit, LAMP_POWER_W, LAMP_R, Reflector, diffuser_plate,
 };
-use crate::{write_mtl, write_obj};
+use crate::templates::{
+    Ccfl, MtlNote, Row, geometry, obj_and_mtl, preamble, scene_file, trace_table,
+};
+use crate::{GenFile, arr, dim, num};
 
-/// The plate's geometry file.
+/// The plate's geometry file (its display-material library is `plate.mtl`).
 pub const OBJ: &str = "plate.obj";
-/// Its display-material library.
-pub const MTL: &str = "plate.mtl";
 
 /// The scene's files below `direct-lit-rows/`.
 pub fn files() -> Vec<GenFile> {
     let d = DirectLit::bundled();
-    let Reflector::Ridges { height } = d.reflector else {
-        unreachable!("the bundled box is ridged")
-    };
-    let mut plate = Part::new("diffuser");
-    hexahedron(
-        &mut plate,
-        &box_corners([0.0, 0.0, DEPTH], [BOX_X, BOX_Y, DEPTH + PLATE_T]),
-        "diffuser_top",
-        "diffuser_back",
-        "diffuser_edge",
-    );
     let header =
         format!("direct-lit-rows: the diffuser plate (see scene.toml). Units mm.\n{GENERATED}");
-    let mtl_header =
-        format!("{header}\nDisplay colours only: blutrace reads the usemtl names as tags.");
-    let parts = [plate];
-    let plate_note = d.plate_note();
-    let text = format!(
+    let [obj, mtl] = obj_and_mtl(
+        "direct-lit-rows",
+        OBJ,
+        &header,
+        &[diffuser_plate()],
+        MtlNote::DisplayOnly,
+    );
+    vec![
+        GenFile::text("direct-lit-rows/scene.toml", scene_toml(&d)),
+        obj,
+        mtl,
+    ]
+}
+
+/// The header: what differs from `direct-lit` and the parameters to vary.
+fn header(d: &DirectLit) -> String {
+    format!(
         "direct-lit-rows: the bundled direct-lit scene (see its scene.toml for the parts and
 their sources) with its six lamps as one source row and its box generated at load.
 {GENERATED}
@@ -50,80 +51,56 @@ Parameters for `blutrace optimize --vary` (README, Optimizing the layout):
 - procedural.0.ridge_height_mm: the back reflector's ridges (0: flat), and
   procedural.0.profile = \"triangle\" | \"parabola\".
 The box's valleys follow the lamps wherever they are.
-"
+",
+        plate_note = d.plate_note()
+    )
+}
+
+/// `direct-lit`'s box as a `[[procedural]]` `direct_lit_box`, its plate and walls as
+/// `direct-lit` writes them, its lamps as one row.
+fn scene_toml(d: &DirectLit) -> String {
+    let Reflector::Ridges { height } = d.reflector else {
+        unreachable!("the bundled box is ridged")
+    };
+    let description = format!(
+        "direct-lit as parameters: a row of {} CCFLs at {} mm pitch over a generated {BOX_X} x {BOX_Y} x {DEPTH} mm ridged box",
+        d.lamps,
+        dim(d.pitch)
     );
-    let mut s = comment(&text);
-    s += &format!(
-        "
-version = 1
-name = \"direct-lit-rows\"
-description = \"direct-lit as parameters: a row of {n} CCFLs at {pitch} mm pitch over a generated {BOX_X} x {BOX_Y} x {DEPTH} mm ridged box\"
-
-[[geometry]]
-file = \"{OBJ}\"
-
-[[procedural]]
+    let procedural = format!(
+        "[[procedural]]
 type = \"direct_lit_box\"
 tag = \"box_reflector\"
 origin = [0.0, 0.0, 0.0]
-size_mm = {size}
-ridge_height_mm = {height}
+size_mm = {}
+ridge_height_mm = {}
 profile = \"triangle\"
-
-{plate}
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {center}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {r}
-length_mm = {len}
-power_w = {p}
-array = {{ count = {n}, pitch_mm = {pitch_num}, direction = [1.0, 0.0, 0.0] }}
-{CCFL_BODY}
-[detector]
-origin = {origin}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {dsize}
-bins = [{bx}, {by}]
-angular_bins = [18, 36]
-
-{trace}",
-        n = d.lamps,
-        pitch = dim(d.pitch),
-        size = arr(&[BOX_X, BOX_Y, DEPTH]),
-        height = num(height),
-        plate = plate_and_walls(&d),
-        center = arr(&[0.5 * BOX_X, 0.5 * BOX_Y, d.lamp_height]),
-        r = num(LAMP_R),
-        len = num(d.lamp_length()),
-        p = num(LAMP_POWER_W),
-        pitch_num = num(d.pitch),
-        origin = arr(&[0.0, 0.0, DEPTH + PLATE_T + super::direct_lit::DETECTOR_GAP]),
-        dsize = arr(&[BOX_X, BOX_Y]),
-        bx = d.bins[0],
-        by = d.bins[1],
-        trace = trace_table(d.photons, 100_000),
+",
+        arr(&[BOX_X, BOX_Y, DEPTH]),
+        num(height)
     );
-    vec![
-        GenFile::text("direct-lit-rows/scene.toml", s),
-        GenFile::text(
-            &format!("direct-lit-rows/{OBJ}"),
-            write_obj(&header, &parts, ObjTags::Usemtl(MTL)),
-        ),
-        GenFile::text(
-            &format!("direct-lit-rows/{MTL}"),
-            write_mtl(&mtl_header, &tags_of(&parts)),
-        ),
-    ]
-}
-
-/// `direct-lit`'s media and surfaces, as its own scene file writes them (from `[media.pc]`
-/// to its first `[[sources]]`), so both scenes keep one plate and one box model.
-fn plate_and_walls(d: &DirectLit) -> String {
-    let full = d.scene_toml(0);
-    let start = full.find("[media.pc]").expect("direct-lit has [media.pc]");
-    let end = full.find("[[sources]]").expect("direct-lit has sources");
-    full[start..end].trim_end().to_string() + "\n"
+    let row = Ccfl {
+        power_w: LAMP_POWER_W,
+        row: Some(Row {
+            count: d.lamps,
+            pitch: d.pitch,
+            direction: [1.0, 0.0, 0.0],
+        }),
+        ..Ccfl::new(
+            "lamp",
+            [0.5 * BOX_X, 0.5 * BOX_Y, d.lamp_height],
+            LAMP_R,
+            d.lamp_length(),
+        )
+    };
+    let mut tables = vec![
+        preamble("direct-lit-rows", &description),
+        geometry(OBJ),
+        procedural,
+    ];
+    tables.extend(d.plate_and_walls());
+    tables.push(row.toml());
+    tables.push(d.detector().toml());
+    tables.push(trace_table(d.photons, 100_000));
+    scene_file(&header(d), &tables)
 }

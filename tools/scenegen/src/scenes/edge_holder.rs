@@ -1,11 +1,13 @@
 //! `edge-holder/`: an edge-lit guide whose lamp holder is procedural (`[[procedural]]`
 //! `lamp_holder`), so its shape is a number of the scene file for `optimize --vary`.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, ObjTags, P3, Part, arr, box_corners, hexahedron, num, tags_of, write_mtl,
-    write_obj,
+use super::GENERATED;
+use crate::shapes::guide_box;
+use crate::templates::{
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
+    preamble, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, arr, num};
 
 /// Guide size (x along the light, y along the lamp, z thickness) (mm).
 pub const SIZE: P3 = [100.0, 60.0, 3.0];
@@ -24,14 +26,6 @@ pub const DOT_DENSITY: f64 = 0.2;
 /// The guide and the reflector sheet under it.
 pub fn parts() -> Vec<Part> {
     let [sx, sy, _] = SIZE;
-    let mut guide = Part::new("guide");
-    hexahedron(
-        &mut guide,
-        &box_corners([0.0; 3], SIZE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
     let mut sheet = Part::new("sheet");
     // From x = 2: clear of any holder up to 4 mm radius.
     let z = -0.2;
@@ -42,27 +36,22 @@ pub fn parts() -> Vec<Part> {
         [sx + 1.0, sy + 1.0, z],
         [sx + 1.0, -1.0, z],
     );
-    vec![guide, sheet]
+    vec![guide_box("guide", SIZE), sheet]
 }
 
 fn scene_toml() -> String {
     let [sx, sy, sz] = SIZE;
-    format!(
-        "# edge-holder: a 100 x 60 x 3 mm PMMA guide lit through its x = 0 edge by one CCFL
-# (r = 1 mm, axis 2 mm before the edge) in a procedural circular lamp holder (Phong,
-# as notebook14's), constant dots (0.2, square, 0.5 mm) on the back, a white sheet under
-# it from x = 2 (the target too, clear of the holder's rim). The holder's radius, aperture and the lamp's place are scene numbers: see the README
-# (\"Optimizing the layout\") for `optimize --vary` on the holder.
-# {GENERATED}
-
-version = 1
-name = \"edge-holder\"
-description = \"Edge-lit guide with a procedural lamp holder\"
-
-[[geometry]]
-file = \"edge-holder.obj\"
-
-[[procedural]]
+    let header = format!(
+        "edge-holder: a 100 x 60 x 3 mm PMMA guide lit through its x = 0 edge by one CCFL
+(r = 1 mm, axis 2 mm before the edge) in a procedural circular lamp holder (Phong,
+as notebook14's), constant dots (0.2, square, 0.5 mm) on the back, a white sheet under
+it from x = 2 (the target too, clear of the holder's rim). The holder's radius, aperture and the lamp's place are scene numbers: see the README
+(\"Optimizing the layout\") for `optimize --vary` on the holder.
+{GENERATED}"
+    );
+    let lamp = [LAMP_X, 0.5 * sy, 0.5 * sz];
+    let holder = format!(
+        "[[procedural]]
 type = \"lamp_holder\"
 tag = \"lamp_reflector\"
 center = {c}
@@ -73,71 +62,43 @@ aperture_mm = {sz}
 section = {{ shape = \"circle\", radius_mm = {r} }}
 segments = 32
 end_caps = true
-
-[media.pmma]
-n = 1.49
-absorption_per_mm = 0.0003
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = 0.9
-lattice = \"square\"
-pitch_mm = 0.5
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {sx}
-density = [{d}]
-
-[surfaces.lamp_reflector]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.8
-exponent = 100.0
-
-[surfaces.reflector_sheet]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.1
-exponent = 10.0
-
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {c}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {lr}
-length_mm = {ll}
-power_w = 1.0
-{CCFL_BODY}
-[detector]
-origin = [2.0, 0.0, {dz}]
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = [{dx}, {sy}]
-bins = [49, 30]
-angular_bins = [18, 36]
-
-{trace}",
-        c = arr(&[LAMP_X, 0.5 * sy, 0.5 * sz]),
-        sx = num(sx),
+",
+        c = arr(&lamp),
         sy = num(sy),
         sz = num(sz),
         r = num(HOLDER_R),
-        d = num(DOT_DENSITY),
-        lr = num(LAMP_R),
-        ll = num(sy - 1.0),
-        dz = num(sz + 0.5),
-        dx = num(sx - 2.0),
-        trace = trace_table(400_000, 100_000),
+    );
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: 0.9,
+        lattice: "square",
+        pitch: 0.5,
+        axis: [1.0, 0.0, 0.0],
+        length: sx,
+        density: &[DOT_DENSITY],
+        normalized: false,
+        mirror: None,
+    };
+    let [front, edge, back] = dotted_guide_faces(&dots);
+    scene_file(
+        &header,
+        &[
+            preamble(
+                "edge-holder",
+                "Edge-lit guide with a procedural lamp holder",
+            ),
+            geometry("edge-holder.obj"),
+            holder,
+            medium("pmma", 1.49, 0.0003, None),
+            front,
+            edge,
+            back,
+            phong("lamp_reflector", 0.95, 0.8, 100.0),
+            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            Ccfl::new("lamp", lamp, LAMP_R, sy - 1.0).toml(),
+            Detector::new([2.0, 0.0, sz + 0.5], [sx - 2.0, sy], [49, 30]).toml(),
+            trace_table(400_000, 100_000),
+        ],
     )
 }
 
@@ -145,15 +106,16 @@ angular_bins = [18, 36]
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
     let header = format!("edge-holder: guide and sheet (see scene.toml). Units mm.\n{GENERATED}");
+    let [obj, mtl] = obj_and_mtl(
+        "edge-holder",
+        "edge-holder.obj",
+        &header,
+        &parts,
+        MtlNote::Plain,
+    );
     vec![
         GenFile::text("edge-holder/scene.toml", scene_toml()),
-        GenFile::text(
-            "edge-holder/edge-holder.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("edge-holder.mtl")),
-        ),
-        GenFile::text(
-            "edge-holder/edge-holder.mtl",
-            write_mtl(&header, &tags_of(&parts)),
-        ),
+        obj,
+        mtl,
     ]
 }

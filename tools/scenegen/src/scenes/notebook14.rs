@@ -1,11 +1,13 @@
 //! `notebook14`: the founding paper's 14-inch notebook backlight, with two lamp holders
 //! of two CCFLs each on the left and right edges of a rectangular PMMA light guide.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, LampHolder, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron,
-    num, tags_of, write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{guide_box, sheet_up};
+use crate::templates::{
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
+    preamble, scene_file, trace_table,
 };
+use crate::{GenFile, LampHolder, P3, Part, dim, triangle_count};
 
 /// Light guide length along x, lamp edge to lamp edge (mm).
 pub const L: f64 = 290.0;
@@ -67,27 +69,17 @@ pub fn lamps() -> Vec<(&'static str, P3)> {
 
 /// The scene's parts: light guide, two lamp holders, reflector sheet.
 pub fn parts() -> Vec<Part> {
-    let mut lgp = Part::new("lgp");
-    hexahedron(
-        &mut lgp,
-        &box_corners([0.0, 0.0, 0.0], [L, W, T]),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
     let left = holder().part("lamp_holder_left", "lamp_reflector");
     let mut right = Part::new("lamp_holder_right");
     right.append_mapped(&left, |p| [L - p[0], p[1], p[2]], true);
-    let mut sheet = Part::new("reflector_sheet");
-    let (x0, x1, z) = (-LIP_GAP, L + LIP_GAP, -SHEET_GAP);
-    sheet.quad(
+    let sheet = sheet_up(
         "reflector_sheet",
-        [x0, 0.0, z],
-        [x1, 0.0, z],
-        [x1, W, z],
-        [x0, W, z],
+        "reflector_sheet",
+        [-LIP_GAP, 0.0],
+        [L + LIP_GAP, W],
+        -SHEET_GAP,
     );
-    vec![lgp, left, right, sheet]
+    vec![guide_box("lgp", [L, W, T]), left, right, sheet]
 }
 
 fn scene_toml(triangles: usize) -> String {
@@ -151,113 +143,56 @@ Geometry: notebook14.obj (tags are its usemtl names), {triangles} triangles.
         x1 = dim(L + LIP_GAP),
         zd = dim(T + DETECTOR_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"notebook14\"
-description = \"14-inch notebook BLU: {L} x {W} x {T} mm PMMA light guide, two CCFLs in each of two lamp holders, constant-density ink dots\"
-
-[[geometry]]
-file = \"notebook14.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = {INK_ALBEDO}
-lattice = \"hex\"
-pitch_mm = {DOT_PITCH}
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {len}
-density = [{DOT_DENSITY}]
-x_unit = \"normalized\"
-mirror = true
-
-[surfaces.lamp_reflector]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.8
-exponent = 100.0
-
-[surfaces.reflector_sheet]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.1
-exponent = 10.0
-",
-        n = num(N_PMMA),
-        len = num(L),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: INK_ALBEDO,
+        lattice: "hex",
+        pitch: DOT_PITCH,
+        axis: [1.0, 0.0, 0.0],
+        length: L,
+        density: &[DOT_DENSITY],
+        normalized: true,
+        mirror: Some(true),
+    };
+    let description = format!(
+        "14-inch notebook BLU: {L} x {W} x {T} mm PMMA light guide, two CCFLs in each of two lamp holders, constant-density ink dots"
     );
+    let mut tables = vec![
+        preamble("notebook14", &description),
+        geometry("notebook14.obj"),
+        medium("pmma", N_PMMA, ABSORPTION, None),
+    ];
+    tables.extend(dotted_guide_faces(&dots));
+    tables.push(phong("lamp_reflector", 0.95, 0.8, 100.0));
+    tables.push(phong("reflector_sheet", 0.95, 0.1, 10.0));
     for (name, c) in lamps() {
-        s += &format!(
-            "
-[[sources]]
-type = \"ccfl\"
-name = \"{name}\"
-center = {}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {}
-length_mm = {}
-power_w = 1.0
-lumens = 300.0
-{CCFL_BODY}",
-            arr(&c),
-            num(LAMP_R),
-            num(W)
-        );
+        let lamp = Ccfl {
+            lumens: Some(300.0),
+            ..Ccfl::new(name, c, LAMP_R, W)
+        };
+        tables.push(lamp.toml());
     }
-    s += &format!(
-        "
-[detector]
-origin = {}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {}
-bins = [100, 100]
-angular_bins = [18, 36]
-
-{}",
-        arr(&[0.0, 0.0, T + DETECTOR_GAP]),
-        arr(&[L, W]),
-        trace_table(400_000, 100_000)
-    );
-    s
+    tables.push(Detector::new([0.0, 0.0, T + DETECTOR_GAP], [L, W], [100, 100]).toml());
+    tables.push(trace_table(400_000, 100_000));
+    scene_file(&header, &tables)
 }
 
 /// `notebook14/scene.toml`, `.obj` and `.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
     let header =
         format!("notebook14: 14-inch notebook backlight (see scene.toml). Units mm.\n{GENERATED}");
+    let [obj, mtl] = obj_and_mtl(
+        "notebook14",
+        "notebook14.obj",
+        &header,
+        &parts,
+        MtlNote::DisplayOnly,
+    );
     vec![
-        GenFile::text("notebook14/scene.toml", scene_toml(triangles)),
-        GenFile::text(
-            "notebook14/notebook14.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("notebook14.mtl")),
-        ),
-        GenFile::text(
-            "notebook14/notebook14.mtl",
-            write_mtl(
-                &format!(
-                    "{header}\nDisplay colours only: blutrace reads the usemtl names as tags."
-                ),
-                &tags_of(&parts),
-            ),
-        ),
+        GenFile::text("notebook14/scene.toml", scene_toml(triangle_count(&parts))),
+        obj,
+        mtl,
     ]
 }
 

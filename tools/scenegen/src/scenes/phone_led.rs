@@ -6,11 +6,13 @@
 //! defects show in the flux map: a bright fan ("hot spot") in front of each LED, dark
 //! wedges between them and dark corners at both ends of the row.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    GenFile, LED_BODY, ObjTags, P3, Part, arr, box_corners, comment, dim, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{guide_box, sheet_up};
+use crate::templates::{
+    Detector, Dots, Led, MtlNote, absorber, dotted_guide_faces, geometry, medium, obj_and_mtl,
+    phong, preamble, scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, comment, dim, num, triangle_count};
 
 /// Light guide length along x, LED edge to far edge (mm).
 pub const L: f64 = 140.0;
@@ -109,14 +111,6 @@ pub fn leds() -> Vec<P3> {
 
 /// The scene's parts: light guide, LED housing, reflector sheet, shielding tape.
 pub fn parts() -> Vec<Part> {
-    let mut lgp = Part::new("lgp");
-    hexahedron(
-        &mut lgp,
-        &box_corners([0.0, 0.0, 0.0], [L, W, T]),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
     // LED housing: back wall at x = -d, top over the LEDs and the air gap (level with the
     // front face), end caps at y = 0 and W; the reflector sheet closes it from below.
     // Normals face into the housing.
@@ -126,14 +120,7 @@ pub fn parts() -> Vec<Part> {
     housing.quad(t, [d, 0.0, T], [d, W, T], [0.0, W, T], [0.0, 0.0, T]);
     housing.quad(t, [d, 0.0, z0], [d, 0.0, T], [0.0, 0.0, T], [0.0, 0.0, z0]);
     housing.quad(t, [d, W, z0], [0.0, W, z0], [0.0, W, T], [d, W, T]);
-    let mut sheet = Part::new("reflector_sheet");
-    sheet.quad(
-        "reflector_sheet",
-        [d, 0.0, z0],
-        [L, 0.0, z0],
-        [L, W, z0],
-        [d, W, z0],
-    );
+    let sheet = sheet_up("reflector_sheet", "reflector_sheet", [d, 0.0], [L, W], z0);
     // Black light-shielding tape over the housing and the first mm of the guide, facing
     // down.
     let mut tape = Part::new("shield_tape");
@@ -145,7 +132,7 @@ pub fn parts() -> Vec<Part> {
         [SHIELD_WIDTH, W, z],
         [SHIELD_WIDTH, 0.0, z],
     );
-    vec![lgp, housing, sheet, tape]
+    vec![guide_box("lgp", [L, W, T]), housing, sheet, tape]
 }
 
 /// `c0 + c1 u + c2 u^2 ...` without the zero terms, for comments.
@@ -220,6 +207,8 @@ fn ies() -> String {
 }
 
 fn scene_toml(triangles: usize) -> String {
+    // Each LED's luminous flux, to 0.01 lm.
+    let lumens = (ies_lumens() * 100.0).round() / 100.0;
     let header = format!(
         "phone-led: a 6.1-inch phone backlight edge-lit by {LEDS} side-view LEDs on one short edge.
 {GENERATED}
@@ -269,7 +258,7 @@ Geometry: phone-led.obj (tags are its usemtl names), {triangles} triangles.
         y1 = dim(leds()[1][1]),
         pitch_s = dim(LED_PITCH),
         xl = dim(-LED_GAP),
-        lm = (ies_lumens() * 100.0).round() / 100.0,
+        lm = lumens,
         xh = dim(-HOUSING_DEPTH),
         end = dim(leds()[0][1]),
         corner = dim(2.0 * leds()[0][1]),
@@ -277,123 +266,65 @@ Geometry: phone-led.obj (tags are its usemtl names), {triangles} triangles.
         zd = dim(T + DETECTOR_GAP),
         zt = dim(T + SHIELD_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"phone-led\"
-description = \"6.1-inch phone BLU: {L} x {W} x {T} mm PMMA light guide edge-lit by {LEDS} side-view LEDs with a tabulated (IES) profile\"
-
-[[geometry]]
-file = \"phone-led.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = {INK_ALBEDO}
-lattice = \"hex\"
-pitch_mm = {DOT_PITCH}
-origin = [0.0, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length_mm = {len}
-density = {density}
-x_unit = \"normalized\"
-
-[surfaces.led_housing]
-model = \"phong\"
-reflectance = 0.9
-specular = 0.1
-exponent = 10.0
-
-[surfaces.reflector_sheet]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.1
-exponent = 10.0
-
-[surfaces.shield_tape]
-model = \"absorber\"
-",
-        n = num(N_PMMA),
-        len = num(L),
-        density = arr(&DOT_DENSITY),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: INK_ALBEDO,
+        lattice: "hex",
+        pitch: DOT_PITCH,
+        axis: [1.0, 0.0, 0.0],
+        length: L,
+        density: &DOT_DENSITY,
+        normalized: true,
+        mirror: None,
+    };
+    let description = format!(
+        "6.1-inch phone BLU: {L} x {W} x {T} mm PMMA light guide edge-lit by {LEDS} side-view LEDs with a tabulated (IES) profile"
     );
+    let mut tables = vec![
+        preamble("phone-led", &description),
+        geometry("phone-led.obj"),
+        medium("pmma", N_PMMA, ABSORPTION, None),
+    ];
+    tables.extend(dotted_guide_faces(&dots));
+    tables.push(phong("led_housing", 0.9, 0.1, 10.0));
+    tables.push(phong("reflector_sheet", 0.95, 0.1, 10.0));
+    tables.push(absorber("shield_tape"));
     for (i, c) in leds().iter().enumerate() {
-        s += &format!(
-            "
-[[sources]]
-type = \"led\"
-name = \"led{}\"
-center = {}
-normal = [1.0, 0.0, 0.0]
-u = [0.0, 1.0, 0.0]
-width_mm = {}
-height_mm = {}
-power_w = {}
-lumens = {:.2}
-intensity_file = \"led.ies\"
-{LED_BODY}",
-            i + 1,
-            arr(c),
-            num(LED_W),
-            num(LED_H),
-            num(LED_POWER_W),
-            ies_lumens()
-        );
+        let name = format!("led{}", i + 1);
+        let led = Led {
+            power_w: LED_POWER_W,
+            lumens: Some(lumens),
+            intensity_file: Some("led.ies"),
+            ..Led::facing_x(&name, *c, [LED_W, LED_H])
+        };
+        tables.push(led.toml());
     }
-    s += &format!(
-        "
-[detector]
-origin = {}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {}
-bins = [{}, {}]
-angular_bins = [18, 36]
-
-{}",
-        arr(&[SHIELD_WIDTH, 0.0, T + DETECTOR_GAP]),
-        arr(&[L - SHIELD_WIDTH, W]),
-        (L - SHIELD_WIDTH) as usize,
-        W as usize,
-        trace_table(400_000, 100_000)
+    let detector = Detector::new(
+        [SHIELD_WIDTH, 0.0, T + DETECTOR_GAP],
+        [L - SHIELD_WIDTH, W],
+        [(L - SHIELD_WIDTH) as usize, W as usize],
     );
-    s
+    tables.push(detector.toml());
+    tables.push(trace_table(400_000, 100_000));
+    scene_file(&header, &tables)
 }
 
 /// `phone-led/scene.toml`, `.obj`, `.mtl`, `led.ies` and `led.csv`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
     let header =
         format!("phone-led: LED edge-lit phone backlight (see scene.toml). Units mm.\n{GENERATED}");
+    let [obj, mtl] = obj_and_mtl(
+        "phone-led",
+        "phone-led.obj",
+        &header,
+        &parts,
+        MtlNote::DisplayOnly,
+    );
     vec![
-        GenFile::text("phone-led/scene.toml", scene_toml(triangles)),
-        GenFile::text(
-            "phone-led/phone-led.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("phone-led.mtl")),
-        ),
-        GenFile::text(
-            "phone-led/phone-led.mtl",
-            write_mtl(
-                &format!(
-                    "{header}\nDisplay colours only: blutrace reads the usemtl names as tags."
-                ),
-                &tags_of(&parts),
-            ),
-        ),
+        GenFile::text("phone-led/scene.toml", scene_toml(triangle_count(&parts))),
+        obj,
+        mtl,
         GenFile::text("phone-led/led.ies", ies()),
         GenFile::text("phone-led/led.csv", csv()),
     ]

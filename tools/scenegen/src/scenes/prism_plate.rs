@@ -4,10 +4,13 @@
 //! everything else identical. `tests/prisms_films.rs` checks the two agree within
 //! statistical error.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    GenFile, ObjTags, P3, Part, arr, comment, dim, dims, num, tags_of, write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{Facing, lamp_box, sheet_up};
+use crate::templates::{
+    Detector, Led, MtlNote, absorber, dielectric, geometry, medium, obj_and_mtl, preamble,
+    scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, arr, dim, dims, num, triangle_count};
 
 /// Plate size (x, y, z) (mm); the plate spans 0..SIZE, lit through its x = 0 end face.
 pub const SIZE: P3 = [20.0, 8.0, 1.0];
@@ -192,36 +195,11 @@ pub fn fan_areas() -> Vec<f64> {
 /// The LED box (five black walls, open towards the plate's end face) and the floor.
 fn surroundings() -> Vec<Part> {
     let [sx, sy, sz] = SIZE;
-    let mut walls = Part::new("absorber");
-    let d = -BOX_DEPTH;
-    let t = "absorber";
-    walls.quad(t, [d, 0.0, 0.0], [d, 0.0, sz], [d, sy, sz], [d, sy, 0.0]);
-    walls.quad(
-        t,
-        [d, 0.0, 0.0],
-        [d, sy, 0.0],
-        [0.0, sy, 0.0],
-        [0.0, 0.0, 0.0],
-    );
-    walls.quad(t, [d, 0.0, sz], [0.0, 0.0, sz], [0.0, sy, sz], [d, sy, sz]);
-    walls.quad(
-        t,
-        [d, 0.0, 0.0],
-        [0.0, 0.0, 0.0],
-        [0.0, 0.0, sz],
-        [d, 0.0, sz],
-    );
-    walls.quad(t, [d, sy, 0.0], [d, sy, sz], [0.0, sy, sz], [0.0, sy, 0.0]);
-    let mut floor = Part::new("floor");
     let [z, m] = FLOOR;
-    floor.quad(
-        "floor",
-        [-m, -m, z],
-        [sx + m, -m, z],
-        [sx + m, sy + m, z],
-        [-m, sy + m, z],
-    );
-    vec![walls, floor]
+    vec![
+        lamp_box("absorber", "absorber", BOX_DEPTH, [sy, sz], Facing::Out),
+        sheet_up("floor", "floor", [-m, -m], [sx + m, sy + m], z),
+    ]
 }
 
 /// Every part of a scene.
@@ -283,11 +261,7 @@ Geometry: {file} (usemtl names are tags), {triangles} triangles.
         zd = dim(sz + DETECTOR_GAP),
     );
     let back = if meshed {
-        "[surfaces.lgp_back]
-model = \"dielectric\"
-inside = \"pmma\"
-"
-        .to_string()
+        dielectric("lgp_back", "pmma")
     } else {
         format!(
             "[surfaces.lgp_back]
@@ -310,105 +284,57 @@ x_unit = \"normalized\"
             fill = arr(&FILL),
         )
     };
-    let name = folder.replace('/', "-");
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"{name}\"
-description = \"Edge-lit PMMA plate {sx} x {sy} x {sz} mm with graded asymmetric V-groove extraction ({kind})\"
-
-[[geometry]]
-file = \"{file}\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = 0.0
-
-[media.black]
-n = {n}
-absorption_per_mm = 1000000000.0
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-{back}
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_side]
-model = \"dielectric\"
-inside = \"pmma\"
-outside = \"black\"
-
-[surfaces.absorber]
-model = \"absorber\"
-
-[surfaces.floor]
-model = \"absorber\"
-
-[[sources]]
-type = \"led\"
-name = \"led\"
-center = {c}
-normal = [1.0, 0.0, 0.0]
-u = [0.0, 1.0, 0.0]
-width_mm = {lw}
-height_mm = {lh}
-power_w = 1.0
-
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [{nb}, 1]
-angular_bins = [18, 36]
-
-{trace}",
-        kind = if meshed { "meshed" } else { "procedural" },
-        n = num(N_PMMA),
-        c = arr(&led()),
-        lw = num(LED[0]),
-        lh = num(LED[1]),
-        o = arr(&[0.0, 0.0, sz + DETECTOR_GAP]),
-        ds = arr(&[sx, sy]),
-        nb = sx.round() as usize,
-        trace = trace_table(200_000, 100_000),
+    let led = Led {
+        body: false,
+        ..Led::facing_x("led", led(), LED)
+    };
+    let kind = if meshed { "meshed" } else { "procedural" };
+    let description = format!(
+        "Edge-lit PMMA plate {sx} x {sy} x {sz} mm with graded asymmetric V-groove extraction ({kind})"
     );
-    s
+    let detector = Detector::new(
+        [0.0, 0.0, sz + DETECTOR_GAP],
+        [sx, sy],
+        [sx.round() as usize, 1],
+    );
+    scene_file(
+        &header,
+        &[
+            preamble(&folder.replace('/', "-"), &description),
+            geometry(file),
+            medium("pmma", N_PMMA, 0.0, None),
+            medium("black", N_PMMA, 1e9, None),
+            dielectric("lgp_front", "pmma"),
+            back,
+            dielectric("lgp_edge", "pmma"),
+            dielectric("lgp_side", "pmma") + "outside = \"black\"\n",
+            absorber("absorber"),
+            absorber("floor"),
+            led.toml(),
+            detector.toml(),
+            trace_table(200_000, 100_000),
+        ],
+    )
 }
 
 fn scene_files(meshed: bool) -> Vec<GenFile> {
     let parts = parts(meshed);
-    let triangles = parts.iter().map(Part::triangle_count).sum();
-    let (folder, stem, mtl) = if meshed {
-        (
-            "test/prism-plate-meshed",
-            "prism-plate-meshed",
-            "prism-plate-meshed.mtl",
-        )
+    let (folder, obj) = if meshed {
+        ("test/prism-plate-meshed", "prism-plate-meshed.obj")
     } else {
-        ("test/prism-plate", "prism-plate", "prism-plate.mtl")
+        ("test/prism-plate", "prism-plate.obj")
     };
     let header = format!(
         "{folder}: edge-lit PMMA plate with V-groove extraction (see scene.toml). Units mm.\n{GENERATED}"
     );
+    let [obj, mtl] = obj_and_mtl(folder, obj, &header, &parts, MtlNote::Plain);
     vec![
         GenFile::text(
             &format!("{folder}/scene.toml"),
-            scene_toml(meshed, triangles),
+            scene_toml(meshed, triangle_count(&parts)),
         ),
-        GenFile::text(
-            &format!("{folder}/{stem}.obj"),
-            write_obj(&header, &parts, ObjTags::Usemtl(mtl)),
-        ),
-        GenFile::text(
-            &format!("{folder}/{stem}.mtl"),
-            write_mtl(&header, &tags_of(&parts)),
-        ),
+        obj,
+        mtl,
     ]
 }
 

@@ -1,11 +1,13 @@
 //! `test/slab`: a lossless, dot-free PMMA slab with a small LED at its centre, emitting
 //! inside the PMMA. For physics tests (Fresnel escape, total internal reflection).
 
-use super::{GENERATED, trace_table};
-use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::guide_box;
+use crate::templates::{
+    Detector, Led, MtlNote, bare_guide_faces, geometry, medium, obj_and_mtl, preamble, scene_file,
+    trace_table,
 };
+use crate::{GenFile, P3, Part, dim, dims, triangle_count};
 
 /// Slab size (x, y, z) (mm); the slab spans 0..SIZE.
 pub const SIZE: P3 = [20.0, 20.0, 2.0];
@@ -23,15 +25,7 @@ pub fn led() -> P3 {
 
 /// The slab.
 pub fn parts() -> Vec<Part> {
-    let mut slab = Part::new("slab");
-    hexahedron(
-        &mut slab,
-        &box_corners([0.0; 3], SIZE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
-    vec![slab]
+    vec![guide_box("slab", SIZE)]
 }
 
 fn scene_toml(triangles: usize) -> String {
@@ -56,74 +50,46 @@ Geometry: slab.obj (usemtl names are tags), {triangles} triangles.
         c = dims(&led()),
         zd = dim(sz + DETECTOR_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"test-slab\"
-description = \"Lossless dot-free PMMA slab {sx} x {sy} x {sz} mm with an LED emitting inside it at its centre\"
-
-[[geometry]]
-file = \"slab.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = 0.0
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[[sources]]
-type = \"led\"
-name = \"led\"
-center = {c}
-normal = [0.0, 0.0, 1.0]
-u = [1.0, 0.0, 0.0]
-width_mm = {w}
-height_mm = {w}
-power_w = 1.0
-cos_exponent = 1.0
-medium = \"pmma\"
-
-[detector]
-origin = {d}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [20, 20]
-angular_bins = [18, 36]
-
-{trace}",
-        n = num(N_PMMA),
-        c = arr(&led()),
-        w = num(LED_SIZE),
-        d = arr(&[0.0, 0.0, sz + DETECTOR_GAP]),
-        ds = arr(&[sx, sy]),
-        trace = trace_table(100_000, 1000),
+    let [front, back, edge] = bare_guide_faces("pmma");
+    let led = Led {
+        cos_exponent: Some(1.0),
+        medium: Some("pmma"),
+        body: false,
+        ..Led::new(
+            "led",
+            led(),
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+            [LED_SIZE, LED_SIZE],
+        )
+    };
+    let description = format!(
+        "Lossless dot-free PMMA slab {sx} x {sy} x {sz} mm with an LED emitting inside it at its centre"
     );
-    s
+    scene_file(
+        &header,
+        &[
+            preamble("test-slab", &description),
+            geometry("slab.obj"),
+            medium("pmma", N_PMMA, 0.0, None),
+            front,
+            back,
+            edge,
+            led.toml(),
+            Detector::new([0.0, 0.0, sz + DETECTOR_GAP], [sx, sy], [20, 20]).toml(),
+            trace_table(100_000, 1000),
+        ],
+    )
 }
 
 /// `test/slab/scene.toml`, `.obj` and `.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
     let header = format!("test/slab: lossless PMMA slab (see scene.toml). Units mm.\n{GENERATED}");
+    let [obj, mtl] = obj_and_mtl("test/slab", "slab.obj", &header, &parts, MtlNote::Plain);
     vec![
-        GenFile::text("test/slab/scene.toml", scene_toml(triangles)),
-        GenFile::text(
-            "test/slab/slab.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("slab.mtl")),
-        ),
-        GenFile::text("test/slab/slab.mtl", write_mtl(&header, &tags_of(&parts))),
+        GenFile::text("test/slab/scene.toml", scene_toml(triangle_count(&parts))),
+        obj,
+        mtl,
     ]
 }

@@ -2,11 +2,13 @@
 //! CCFL in a black box. Light that enters through the end face is totally reflected at the
 //! front, back and side faces, so none should reach the detector above the front face.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    GenFile, ObjTags, P3, Part, arr, box_corners, comment, dim, dims, hexahedron, num, tags_of,
-    write_mtl, write_obj,
+use super::GENERATED;
+use crate::shapes::{Facing, guide_box, lamp_box};
+use crate::templates::{
+    Ccfl, Detector, MtlNote, absorber, bare_guide_faces, geometry, medium, obj_and_mtl, preamble,
+    scene_file, trace_table,
 };
+use crate::{GenFile, P3, Part, dim, dims, triangle_count};
 
 /// Plate size (x, y, z) (mm); the plate spans 0..SIZE, lit through its x = 0 end face.
 pub const SIZE: P3 = [100.0, 20.0, 2.0];
@@ -27,37 +29,10 @@ pub fn lamp() -> P3 {
 /// The plate and the absorber box.
 pub fn parts() -> Vec<Part> {
     let [_, sy, sz] = SIZE;
-    let mut plate = Part::new("plate");
-    hexahedron(
-        &mut plate,
-        &box_corners([0.0; 3], SIZE),
-        "lgp_front",
-        "lgp_back",
-        "lgp_edge",
-    );
     // Five absorbing walls of the box x = -d..0, y 0..sy, z 0..sz; the sixth side is the
     // plate's end face. The walls meet the plate only along its end face's edges.
-    let mut walls = Part::new("absorber");
-    let d = -BOX_DEPTH;
-    let t = "absorber";
-    walls.quad(t, [d, 0.0, 0.0], [d, 0.0, sz], [d, sy, sz], [d, sy, 0.0]);
-    walls.quad(
-        t,
-        [d, 0.0, 0.0],
-        [d, sy, 0.0],
-        [0.0, sy, 0.0],
-        [0.0, 0.0, 0.0],
-    );
-    walls.quad(t, [d, 0.0, sz], [0.0, 0.0, sz], [0.0, sy, sz], [d, sy, sz]);
-    walls.quad(
-        t,
-        [d, 0.0, 0.0],
-        [0.0, 0.0, 0.0],
-        [0.0, 0.0, sz],
-        [d, 0.0, sz],
-    );
-    walls.quad(t, [d, sy, 0.0], [d, sy, sz], [0.0, sy, sz], [0.0, sy, 0.0]);
-    vec![plate, walls]
+    let walls = lamp_box("absorber", "absorber", BOX_DEPTH, [sy, sz], Facing::Out);
+    vec![guide_box("plate", SIZE), walls]
 }
 
 fn scene_toml(triangles: usize) -> String {
@@ -84,81 +59,51 @@ Geometry: slab-edge-lit.obj (usemtl names are tags), {triangles} triangles.
         c = dims(&lamp()),
         zd = dim(sz + DETECTOR_GAP),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"test-slab-edge-lit\"
-description = \"Lossless dot-free PMMA plate {sx} x {sy} x {sz} mm lit through one end face by a boxed-in CCFL\"
-
-[[geometry]]
-file = \"slab-edge-lit.obj\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = 0.0
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.absorber]
-model = \"absorber\"
-
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {c}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {r}
-length_mm = {l}
-power_w = 1.0
-
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [100, 20]
-angular_bins = [18, 36]
-
-{trace}",
-        n = num(N_PMMA),
-        c = arr(&lamp()),
-        r = num(LAMP_R),
-        l = num(sy),
-        o = arr(&[0.0, 0.0, sz + DETECTOR_GAP]),
-        ds = arr(&[sx, sy]),
-        trace = trace_table(100_000, 100_000),
+    let [front, back, edge] = bare_guide_faces("pmma");
+    let lamp = Ccfl {
+        body: false,
+        ..Ccfl::new("lamp", lamp(), LAMP_R, sy)
+    };
+    let description = format!(
+        "Lossless dot-free PMMA plate {sx} x {sy} x {sz} mm lit through one end face by a boxed-in CCFL"
     );
-    s
+    scene_file(
+        &header,
+        &[
+            preamble("test-slab-edge-lit", &description),
+            geometry("slab-edge-lit.obj"),
+            medium("pmma", N_PMMA, 0.0, None),
+            front,
+            back,
+            edge,
+            absorber("absorber"),
+            lamp.toml(),
+            Detector::new([0.0, 0.0, sz + DETECTOR_GAP], [sx, sy], [100, 20]).toml(),
+            trace_table(100_000, 100_000),
+        ],
+    )
 }
 
 /// `test/slab-edge-lit/scene.toml`, `.obj` and `.mtl`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
     let header = format!(
         "test/slab-edge-lit: edge-lit lossless PMMA plate (see scene.toml). Units mm.\n{GENERATED}"
     );
+    let [obj, mtl] = obj_and_mtl(
+        "test/slab-edge-lit",
+        "slab-edge-lit.obj",
+        &header,
+        &parts,
+        MtlNote::Plain,
+    );
     vec![
-        GenFile::text("test/slab-edge-lit/scene.toml", scene_toml(triangles)),
         GenFile::text(
-            "test/slab-edge-lit/slab-edge-lit.obj",
-            write_obj(&header, &parts, ObjTags::Usemtl("slab-edge-lit.mtl")),
+            "test/slab-edge-lit/scene.toml",
+            scene_toml(triangle_count(&parts)),
         ),
-        GenFile::text(
-            "test/slab-edge-lit/slab-edge-lit.mtl",
-            write_mtl(&header, &tags_of(&parts)),
-        ),
+        obj,
+        mtl,
     ]
 }
 

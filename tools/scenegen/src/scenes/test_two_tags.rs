@@ -1,8 +1,12 @@
 //! `test/two-tags`: a Lambertian floor and a mirror wall lit by an LED, with tags taken
 //! from OBJ `o`/`g` names (no materials). For loader tests.
 
-use super::{GENERATED, trace_table};
-use crate::{GenFile, ObjTags, P3, Part, arr, comment, dims, write_obj};
+use super::GENERATED;
+use crate::shapes::sheet_up;
+use crate::templates::{
+    Detector, Led, geometry, lambert, mirror, preamble, scene_file, trace_table,
+};
+use crate::{GenFile, ObjTags, P3, Part, dims, triangle_count, write_obj};
 
 /// Floor side (mm): the floor spans x, y 0..FLOOR at z = 0.
 pub const FLOOR: f64 = 10.0;
@@ -16,14 +20,7 @@ pub const DETECTOR_Z: f64 = 6.0;
 /// The floor (`o diffuser`) and the mirror wall (`g mirror`).
 pub fn parts() -> Vec<Part> {
     let f = FLOOR;
-    let mut floor = Part::new("diffuser");
-    floor.quad(
-        "diffuser",
-        [0.0, 0.0, 0.0],
-        [f, 0.0, 0.0],
-        [f, f, 0.0],
-        [0.0, f, 0.0],
-    );
+    let floor = sheet_up("diffuser", "diffuser", [0.0, 0.0], [f, f], 0.0);
     let mut wall = Part::new("mirror");
     wall.quad(
         "mirror",
@@ -50,55 +47,35 @@ Geometry: two-tags.obj, {triangles} triangles.
 ",
         led = dims(&LED),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"test-two-tags\"
-description = \"A Lambertian floor and a mirror wall lit by an LED; tags from OBJ o/g names\"
-
-[[geometry]]
-file = \"two-tags.obj\"
-
-[surfaces.diffuser]
-model = \"lambert\"
-albedo = 0.8
-
-[surfaces.mirror]
-model = \"mirror\"
-reflectance = 0.9
-
-[[sources]]
-type = \"led\"
-name = \"led\"
-center = {led}
-normal = [0.0, 0.0, -1.0]
-u = [1.0, 0.0, 0.0]
-width_mm = 1.0
-height_mm = 1.0
-power_w = 1.0
-
-[detector]
-origin = {o}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [10, 10]
-angular_bins = [9, 12]
-
-{trace}",
-        led = arr(&LED),
-        o = arr(&[0.0, 0.0, DETECTOR_Z]),
-        ds = arr(&[FLOOR, FLOOR]),
-        trace = trace_table(10_000, 1000),
-    );
-    s
+    let led = Led {
+        body: false,
+        ..Led::new("led", LED, [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [1.0, 1.0])
+    };
+    let detector = Detector {
+        angular_bins: [9, 12],
+        ..Detector::new([0.0, 0.0, DETECTOR_Z], [FLOOR, FLOOR], [10, 10])
+    };
+    scene_file(
+        &header,
+        &[
+            preamble(
+                "test-two-tags",
+                "A Lambertian floor and a mirror wall lit by an LED; tags from OBJ o/g names",
+            ),
+            geometry("two-tags.obj"),
+            lambert("diffuser", 0.8),
+            mirror("mirror", 0.9),
+            led.toml(),
+            detector.toml(),
+            trace_table(10_000, 1000),
+        ],
+    )
 }
 
 /// `test/two-tags/scene.toml` and `.obj`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
+    let triangles = triangle_count(&parts);
     let header = format!(
         "test/two-tags: floor and mirror (see scene.toml). Units mm. Tags are o/g names.\n{GENERATED}"
     );

@@ -1,10 +1,12 @@
 //! `wedge-ccfl`: a wedge light guide lit by one CCFL on its thick edge, stored as glTF 2.0
 //! (`.gltf` JSON plus a `.bin` buffer) under a translated root node.
 
-use super::{GENERATED, trace_table};
-use crate::{
-    CCFL_BODY, GenFile, LampHolder, P3, Part, arr, comment, dim, dims, hexahedron, num, write_gltf,
+use super::GENERATED;
+use crate::templates::{
+    Ccfl, Detector, Dots, dotted_guide_faces, geometry, medium, phong, preamble, scene_file,
+    trace_table,
 };
+use crate::{GenFile, LampHolder, P3, Part, dim, dims, hexahedron, triangle_count, write_gltf};
 
 /// Light guide length along x, lamp edge to far edge (mm).
 pub const L: f64 = 200.0;
@@ -157,90 +159,43 @@ are world coordinates in millimetres, z up.
         zd = dim(T0 + DETECTOR_GAP),
         tr = dims(&ROOT_TRANSLATION),
     );
-    let mut s = comment(&header);
-    s += &format!(
-        "
-version = 1
-name = \"wedge-ccfl\"
-description = \"Wedge PMMA light guide {L} x {W} mm, {T0} to {T1} mm thick, one CCFL on the thick edge, constant-density ink dots on the sloping back face\"
-
-[[geometry]]
-file = \"wedge-ccfl.gltf\"
-
-[media.pmma]
-n = {n}
-absorption_per_mm = {ABSORPTION}
-
-[surfaces.lgp_front]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_edge]
-model = \"dielectric\"
-inside = \"pmma\"
-
-[surfaces.lgp_back]
-model = \"dots\"
-inside = \"pmma\"
-ink_albedo = {INK_ALBEDO}
-lattice = \"square\"
-pitch_mm = {DOT_PITCH}
-origin = [0.0, 0.0, 0.0]
-axis = [{a0:?}, {a1:?}, {a2:?}]
-length_mm = {len}
-density = [{DOT_DENSITY}]
-x_unit = \"normalized\"
-mirror = false
-
-[surfaces.lamp_reflector]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.8
-exponent = 100.0
-
-[surfaces.reflector_sheet]
-model = \"phong\"
-reflectance = 0.95
-specular = 0.1
-exponent = 10.0
-
-[[sources]]
-type = \"ccfl\"
-name = \"lamp\"
-center = {c}
-axis = [0.0, 1.0, 0.0]
-radius_mm = {lr}
-length_mm = {lw}
-power_w = 1.0
-{CCFL_BODY}
-[detector]
-origin = {d}
-u = [1.0, 0.0, 0.0]
-v = [0.0, 1.0, 0.0]
-size_mm = {ds}
-bins = [100, 100]
-angular_bins = [18, 36]
-
-{trace}",
-        n = num(N_PMMA),
-        a0 = axis[0],
-        a1 = axis[1],
-        a2 = axis[2],
-        len = num(L.hypot(T0 - T1)),
-        c = arr(&lamp),
-        lr = num(LAMP_R),
-        lw = num(W),
-        d = arr(&[0.0, 0.0, T0 + DETECTOR_GAP]),
-        ds = arr(&[L, W]),
-        trace = trace_table(400_000, 100_000),
+    let dots = Dots {
+        inside: "pmma",
+        ink_albedo: INK_ALBEDO,
+        lattice: "square",
+        pitch: DOT_PITCH,
+        axis,
+        length: L.hypot(T0 - T1),
+        density: &[DOT_DENSITY],
+        normalized: true,
+        mirror: Some(false),
+    };
+    let [front, edge, back] = dotted_guide_faces(&dots);
+    let description = format!(
+        "Wedge PMMA light guide {L} x {W} mm, {T0} to {T1} mm thick, one CCFL on the thick edge, constant-density ink dots on the sloping back face"
     );
-    s
+    scene_file(
+        &header,
+        &[
+            preamble("wedge-ccfl", &description),
+            geometry("wedge-ccfl.gltf"),
+            medium("pmma", N_PMMA, ABSORPTION, None),
+            front,
+            edge,
+            back,
+            phong("lamp_reflector", 0.95, 0.8, 100.0),
+            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            Ccfl::new("lamp", lamp, LAMP_R, W).toml(),
+            Detector::new([0.0, 0.0, T0 + DETECTOR_GAP], [L, W], [100, 100]).toml(),
+            trace_table(400_000, 100_000),
+        ],
+    )
 }
 
 /// `wedge-ccfl/scene.toml`, `.gltf` and `.bin`.
 pub fn files() -> Vec<GenFile> {
     let parts = parts();
-    let triangles = parts.iter().map(Part::triangle_count).sum();
+    let triangles = triangle_count(&parts);
     let (json, bin) = write_gltf(
         "wedge-ccfl",
         "blu",

@@ -20,7 +20,6 @@ mod flight;
 
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
-use crate::detector::AngularBinning;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
@@ -51,8 +50,6 @@ pub struct Tracer<'a> {
     /// The unit normal of every triangle of the scene's mesh
     /// ([`crate::geometry::Mesh::unit_normals`]).
     pub normals: &'a [DVec3],
-    /// The target's angular bins ([`AngularBinning::new`] of the scene's detector).
-    pub angular: AngularBinning,
 }
 
 /// A photon in flight.
@@ -105,7 +102,7 @@ impl Tracer<'_> {
             }
             if let Some((_, ab)) = detected {
                 out.detections
-                    .push(self.detection(ab, true_ray.dir, p.weight));
+                    .push(detection(scene, ab, true_ray.dir, p.weight));
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
@@ -220,16 +217,6 @@ impl Tracer<'_> {
             }
         }
         best
-    }
-
-    /// The detection of a photon of `weight` crossing the target at in-plane coordinates
-    /// `ab` along `dir`.
-    fn detection(&self, ab: [f64; 2], dir: DVec3, weight: f64) -> Detection {
-        Detection {
-            flux_bin: self.scene.detector.flux_index(ab) as u32,
-            angular_bin: self.angular.index(dir) as u32,
-            weight,
-        }
     }
 
     /// The surface model a photon meets.
@@ -412,5 +399,14 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
         true
     } else {
         false
+    }
+}
+
+fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Detection {
+    let d = &scene.detector;
+    Detection {
+        flux_bin: d.flux_index(ab) as u32,
+        angular_bin: d.angular_index(dir) as u32,
+        weight,
     }
 }

@@ -24,7 +24,6 @@ pub mod metrics;
 pub mod summary;
 
 use crate::accel::{self, Accel, BackendChoice};
-use crate::detector::AngularBinning;
 use crate::optics::surface::Estimator;
 use crate::output::{
     self,
@@ -281,7 +280,6 @@ pub fn trace<'a>(
         accel: accel.as_ref(),
         estimator: options.estimator,
         convex: options.convex,
-        angular: AngularBinning::new(&scene.detector),
     };
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();

@@ -17,6 +17,7 @@
 //! not depend on the thread count.
 
 mod flight;
+mod solid_walk;
 
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
@@ -28,6 +29,7 @@ use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
 use flight::Flight;
 use glam::DVec3;
 use rayon::prelude::*;
+use solid_walk::Walks;
 
 /// Photons per work unit. Fixed, so results never depend on scheduling.
 pub const CHUNK: u64 = 4096;
@@ -50,6 +52,8 @@ pub struct Tracer<'a> {
     /// The unit normal of every triangle of the scene's mesh
     /// ([`crate::geometry::Mesh::unit_normals`]).
     pub normals: &'a [DVec3],
+    /// Where photons go face to face inside a convex solid ([`solid_walk`]).
+    walks: Walks<'a>,
 }
 
 /// A photon in flight.
@@ -63,7 +67,27 @@ struct Photon {
     absorption_depth: f64,
 }
 
-impl Tracer<'_> {
+impl<'a> Tracer<'a> {
+    /// A tracer of `scene` through `accel`, with the triangles' unit `normals`
+    /// ([`crate::geometry::Mesh::unit_normals`]); `convex` turns the convex-solid fast
+    /// path on.
+    pub fn new(
+        scene: &'a Scene,
+        accel: &'a dyn Accel,
+        estimator: Estimator,
+        convex: bool,
+        normals: &'a [DVec3],
+    ) -> Tracer<'a> {
+        Tracer {
+            scene,
+            accel,
+            estimator,
+            convex,
+            normals,
+            walks: Walks::new(scene, convex),
+        }
+    }
+
     /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
     fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
@@ -83,7 +107,15 @@ impl Tracer<'_> {
     /// The photon loop: nearest event, the medium on the way, surface roulette, repeat.
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
-        for _ in 0..scene.max_bounces {
+        let mut events = 0;
+        while events < scene.max_bounces {
+            if let Some(solid) = self.walks.solid(p.medium) {
+                match self.walk_solid(solid, p, rng, out, &mut events) {
+                    Some(fate) => return fate,
+                    None => continue,
+                }
+            }
+            events += 1;
             let true_ray = p.ray.true_ray();
             let surf = self.nearest_surface(p, &true_ray);
             let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
@@ -255,41 +287,10 @@ impl Tracer<'_> {
             }
             return flight;
         }
-        let a = medium.absorption_per_mm;
-        if a == 0.0 {
-            return Flight::Reached;
-        }
-        match self.estimator {
-            // A photon leaving the scene inside an absorbing medium (t infinite: the
-            // black surround the physics and stability tests use to catch leaks) is
-            // absorbed there, under both estimators.
-            Estimator::Analog => {
-                // Absorption is memoryless: one exponential depth per photon, spent
-                // segment by segment (a t each), has the law of a fresh free path per
-                // segment, without a logarithm and a random draw on every segment.
-                if p.absorption_depth < 0.0 {
-                    p.absorption_depth = -(1.0 - rng.uniform()).ln();
-                }
-                let spent = a * t;
-                if spent > p.absorption_depth {
-                    return Flight::Absorbed;
-                }
-                p.absorption_depth -= spent;
-                Flight::Reached
-            }
-            Estimator::Weighted => {
-                // exp(-a t) at any length, to infinity included: a photon leaving the
-                // scene inside an absorbing medium leaves all its weight to it, as the
-                // analog photon is absorbed there.
-                let w = if t.is_finite() {
-                    p.weight * (-a * t).exp()
-                } else {
-                    0.0
-                };
-                Ledger::lose(sink, p.weight, w);
-                p.weight = w;
-                Flight::Reached
-            }
+        if absorb_clear(p, medium.absorption_per_mm, t, self.estimator, rng, sink) {
+            Flight::Absorbed
+        } else {
+            Flight::Reached
         }
     }
 
@@ -386,6 +387,51 @@ impl Struck {
 struct Hit {
     surf: SurfaceHit,
     struck: Struck,
+}
+
+/// Beer-Lambert along `t` through a clear medium absorbing `a` per mm (analog: true when
+/// the photon is absorbed; weighted: its weight attenuated and the loss booked to `sink`).
+/// A photon leaving the scene inside an absorbing medium (t infinite: the black surround
+/// the physics and stability tests use to catch leaks) is absorbed there, under both
+/// estimators.
+fn absorb_clear(
+    p: &mut Photon,
+    a: f64,
+    t: f64,
+    estimator: Estimator,
+    rng: &mut PhotonRng,
+    sink: &mut ExactSum,
+) -> bool {
+    if a == 0.0 {
+        return false;
+    }
+    match estimator {
+        Estimator::Analog => {
+            // Absorption is memoryless: one exponential depth per photon, spent
+            // segment by segment (a t each), has the law of a fresh free path per
+            // segment, without a logarithm and a random draw on every segment.
+            if p.absorption_depth < 0.0 {
+                p.absorption_depth = -(1.0 - rng.uniform()).ln();
+            }
+            let spent = a * t;
+            if spent > p.absorption_depth {
+                return true;
+            }
+            p.absorption_depth -= spent;
+            false
+        }
+        Estimator::Weighted => {
+            // exp(-a t) at any length, to infinity included.
+            let w = if t.is_finite() {
+                p.weight * (-a * t).exp()
+            } else {
+                0.0
+            };
+            Ledger::lose(sink, p.weight, w);
+            p.weight = w;
+            false
+        }
+    }
 }
 
 /// Russian roulette on low weights (weighted estimator only): false when the photon dies.

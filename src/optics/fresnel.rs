@@ -52,6 +52,7 @@ pub fn critical_angle(n1: f64, n2: f64) -> Option<f64> {
 }
 
 /// Mirror reflection of `dir` about the unit normal `n` (either orientation).
+#[inline]
 pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
     dir - 2.0 * dir.dot(n) * n
 }
@@ -76,6 +77,7 @@ fn refracted(dir: DVec3, n: DVec3, cos_i: f64, cos_t: f64, eta: f64) -> DVec3 {
 /// refracted along `t`; `None`: reflected (the caller mirrors `dir` about `facing`).
 ///
 /// One uniform is drawn, unless R = 1.
+#[inline]
 pub fn roulette(dir: DVec3, facing: DVec3, n1: f64, n2: f64, rng: &mut PhotonRng) -> Option<DVec3> {
     // [`reflectance`] then [`refract`], sharing the cosines: total internal reflection
     // (most hits inside a guide) leaves after one square root and no draw.

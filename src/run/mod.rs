@@ -274,13 +274,13 @@ pub fn trace<'a>(
     let accel: Box<dyn Accel> =
         pool.install(|| accel::build(options.backend, scene.mesh.clone()))?;
     let normals = scene.mesh.unit_normals();
-    let tracer = Tracer {
+    let tracer = Tracer::new(
         scene,
-        normals: &normals,
-        accel: accel.as_ref(),
-        estimator: options.estimator,
-        convex: options.convex,
-    };
+        accel.as_ref(),
+        options.estimator,
+        options.convex,
+        &normals,
+    );
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();
     let stopped_by = loop {

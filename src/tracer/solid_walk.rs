@@ -1,0 +1,292 @@
+//! Face to face inside a convex solid: the photon loop when nothing but the solid's own
+//! faces can end a segment.
+//!
+//! A photon in a light guide spends most of its events bouncing between the guide's
+//! faces. Where the medium has a [`ConvexSolid`] (the convex path), the solid lies clear
+//! of the target, no lamp body sits in that medium and the medium does not scatter, the
+//! general loop's tests for bodies, the target and the backend cannot change anything:
+//! here the photon goes from exit face to exit face until it leaves the medium or meets
+//! its fate. The two faces a guide is made of are taken without the general dispatch:
+//! a smooth dielectric face (`model = "dielectric"`) and a dotted one (`model = "dots"`)
+//! with its refractive indices looked up once; every other model goes through
+//! [`SurfaceModel::interact_on`].
+//!
+//! The same physics and the same random numbers, in the same order, as the general
+//! loop: traced chunks are identical bit for bit with the walk on and off (tested).
+//! Measured (single-thread CPU time, interleaved runs): 16 % more photons/s on
+//! bench-box, 4 % on notebook14 (its photons spend more of their events in the lamp
+//! cavities). The Fresnel roulette is inlined here: called through memory it cost the
+//! walk its gain.
+
+use super::{Photon, Tracer, absorb_clear, roulette};
+use crate::accel::convex::ConvexSolid;
+use crate::estimator::Estimator;
+use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
+use crate::optics::dots::DotPattern;
+use crate::optics::fresnel;
+use crate::optics::lambert;
+use crate::optics::medium::{Interface, MediumId};
+use crate::optics::surface::{Feature, Outcome, SurfaceModel};
+use crate::rng::PhotonRng;
+use crate::scene::Scene;
+use crate::tally::{ChunkTally, Fate, Ledger};
+use glam::DVec3;
+
+/// A tag's surface model as the walk takes it.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Face<'a> {
+    /// A smooth dielectric face: its interface and the indices behind and in front.
+    Smooth(Smooth),
+    /// A dotted face: ink where a dot is, else the smooth face.
+    Dotted {
+        smooth: Smooth,
+        pattern: &'a DotPattern,
+        ink_albedo: f64,
+    },
+    /// Any other model, through [`SurfaceModel::interact_on`].
+    Other,
+}
+
+/// A smooth interface with its two refractive indices.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Smooth {
+    iface: Interface,
+    n_inside: f64,
+    n_outside: f64,
+}
+
+/// What the walk needs of a scene: each tag's face and, per medium, the solid to walk.
+pub(super) struct Walks<'a> {
+    faces: Vec<Face<'a>>,
+    solids: Vec<Option<&'a ConvexSolid>>,
+}
+
+impl<'a> Walks<'a> {
+    /// The walks of `scene` (none when the convex path is off).
+    pub(super) fn new(scene: &'a Scene, convex: bool) -> Walks<'a> {
+        let n = |m: MediumId| scene.media[m as usize].n;
+        let smooth = |iface: &Interface| Smooth {
+            iface: *iface,
+            n_inside: n(iface.inside),
+            n_outside: n(iface.outside),
+        };
+        let faces = scene
+            .surfaces
+            .iter()
+            .map(|model| match model {
+                SurfaceModel::Dielectric(i) => Face::Smooth(smooth(i)),
+                SurfaceModel::Dots {
+                    interface,
+                    pattern,
+                    ink_albedo,
+                } => Face::Dotted {
+                    smooth: smooth(interface),
+                    pattern,
+                    ink_albedo: *ink_albedo,
+                },
+                _ => Face::Other,
+            })
+            .collect();
+        let walkable = |m: usize| {
+            let solid = scene.convex_solid(m as MediumId).filter(|_| convex)?;
+            let clear = solid.clear_of_target && scene.media[m].scattering.per_mm == 0.0;
+            let no_body = scene
+                .sources
+                .bodies()
+                .all(|(_, s, _)| s.medium as usize != m);
+            (clear && no_body).then_some(solid)
+        };
+        Walks {
+            faces,
+            solids: (0..scene.media.len()).map(walkable).collect(),
+        }
+    }
+
+    /// The solid to walk in medium `m`, if any.
+    pub(super) fn solid(&self, m: MediumId) -> Option<&'a ConvexSolid> {
+        self.solids[m as usize]
+    }
+}
+
+/// What one face did to the photon.
+struct Step {
+    outcome: Outcome,
+    feature: Feature,
+}
+
+impl Tracer<'_> {
+    /// Follow `p` from face to face of `solid` until it leaves the solid's medium
+    /// (`None`, `p` set up to go on in the general loop) or meets its fate, counting
+    /// events in `events` as the general loop does.
+    pub(super) fn walk_solid(
+        &self,
+        solid: &ConvexSolid,
+        p: &mut Photon,
+        rng: &mut PhotonRng,
+        out: &mut ChunkTally,
+        events: &mut u32,
+    ) -> Option<Fate> {
+        let scene = self.scene;
+        let (medium, absorption) = (p.medium, scene.media[p.medium as usize].absorption_per_mm);
+        let mut ray = p.ray.true_ray();
+        while *events < scene.max_bounces {
+            *events += 1;
+            let exit = solid.exit(&scene.mesh, &ray);
+            let t = exit.map_or(f64::INFINITY, |h| h.t);
+            let sink = &mut out.ledger.absorbed_in_medium[medium as usize];
+            if absorb_clear(p, absorption, t, self.estimator, rng, sink) {
+                return Some(Fate::AbsorbedInMedium(medium));
+            }
+            let Some(h) = exit else {
+                return Some(Fate::Escaped);
+            };
+            let tag = scene.mesh.tri_tag[h.prim as usize];
+            let surf = SurfaceHit {
+                t: h.t,
+                prim: h.prim,
+                point: ray.at(h.t),
+                normal: self.normals[h.prim as usize],
+            };
+            let step = self.face_step(tag, &surf, ray.dir, medium, rng);
+            out.ledger.hit(tag, step.feature != Feature::Plain);
+            let Outcome::Scattered {
+                dir,
+                medium: next,
+                weight,
+            } = step.outcome
+            else {
+                return Some(Fate::AbsorbedBySurface(tag));
+            };
+            let w = p.weight * weight;
+            Ledger::lose(
+                &mut out.ledger.absorbed_by_surface[tag as usize],
+                p.weight,
+                w,
+            );
+            p.weight = w;
+            ray = Ray::new(surf.point, dir);
+            if !roulette(p, rng, &mut out.ledger) {
+                return Some(Fate::Roulette);
+            }
+            if next != medium {
+                p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
+                p.medium = next;
+                return None;
+            }
+        }
+        None
+    }
+
+    /// The face of tag `tag` met at `surf` along `dir` by a photon in `medium`: what
+    /// [`SurfaceModel::interact_on`] does, the guide's two faces taken directly.
+    fn face_step(
+        &self,
+        tag: u32,
+        surf: &SurfaceHit,
+        dir: DVec3,
+        medium: MediumId,
+        rng: &mut PhotonRng,
+    ) -> Step {
+        // As interact_on and dielectric::scatter decide it (NaN counts as leaving).
+        let entering = dir.dot(surf.normal) < 0.0;
+        let plain = |outcome| Step {
+            outcome,
+            feature: Feature::Plain,
+        };
+        match self.walks.faces[tag as usize] {
+            Face::Smooth(s) if !entering => plain(s.leave(surf.normal, dir, rng)),
+            Face::Dotted {
+                smooth,
+                pattern,
+                ink_albedo,
+            } if !entering => {
+                if pattern.meets_ink(surf.point, rng) {
+                    let outcome = ink(ink_albedo, -surf.normal, medium, self.estimator, rng);
+                    return Step {
+                        outcome,
+                        feature: Feature::Ink,
+                    };
+                }
+                plain(smooth.leave(surf.normal, dir, rng))
+            }
+            _ => {
+                let model = &self.scene.surfaces[tag as usize];
+                let (outcome, feature) =
+                    model.interact_on(&self.scene.media, surf, dir, medium, self.estimator, rng);
+                Step { outcome, feature }
+            }
+        }
+    }
+}
+
+impl Smooth {
+    /// `optics::dielectric::scatter` for a photon leaving through the face (`dir` not
+    /// against the outward `normal`): Fresnel roulette from inside to outside.
+    fn leave(&self, normal: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Outcome {
+        let facing = -normal;
+        let (dir, medium) = match fresnel::roulette(dir, facing, self.n_inside, self.n_outside, rng)
+        {
+            Some(t) => (t, self.iface.outside),
+            None => (fresnel::reflect(dir, facing), self.iface.inside),
+        };
+        Outcome::Scattered {
+            dir,
+            medium,
+            weight: 1.0,
+        }
+    }
+}
+
+/// Ink of albedo `albedo` met from the side `facing` points to: albedo roulette (or
+/// weight), then a Lambertian direction back into `medium`.
+fn ink(
+    albedo: f64,
+    facing: DVec3,
+    medium: MediumId,
+    estimator: Estimator,
+    rng: &mut PhotonRng,
+) -> Outcome {
+    match estimator.survive(albedo, rng) {
+        Some(weight) => Outcome::Scattered {
+            dir: lambert::direction(facing, rng),
+            medium,
+            weight,
+        },
+        None => Outcome::Absorbed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{self, BackendChoice};
+    use crate::tally::ChunkTally;
+
+    /// Chunks traced with the walk and without it (the general loop all the way, on the
+    /// same convex path) are the same bits: ledgers and detections.
+    #[test]
+    fn the_walk_is_the_general_loop_bit_for_bit() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        for name in ["bench-box", "notebook14", "wedge-ccfl"] {
+            let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
+            let accel = accel::build(BackendChoice::Bvh, scene.mesh.clone()).unwrap();
+            let normals = scene.mesh.unit_normals();
+            for estimator in [Estimator::Analog, Estimator::Weighted] {
+                let walking = Tracer::new(&scene, accel.as_ref(), estimator, true, &normals);
+                assert!(
+                    walking.walks.solids.iter().any(Option::is_some),
+                    "{name}: nothing to walk"
+                );
+                let mut general = Tracer::new(&scene, accel.as_ref(), estimator, true, &normals);
+                general.walks.solids.iter_mut().for_each(|s| *s = None);
+                let trace = |t: &Tracer, chunk| -> ChunkTally { t.trace_chunk(5, chunk, u64::MAX) };
+                for chunk in [0, 7] {
+                    let (a, b) = (trace(&walking, chunk), trace(&general, chunk));
+                    assert_eq!(a.ledger, b.ledger, "{name} {estimator:?} chunk {chunk}");
+                    assert_eq!(a.detections, b.detections, "{name} {estimator:?}");
+                    assert!(a.ledger.interactions > 3 * a.ledger.photons, "{name}");
+                }
+            }
+        }
+    }
+}

@@ -34,6 +34,7 @@
 //! The random placements draw each cell's dots from `(placement_seed, cell)` only, so the
 //! same seed always gives the same sheet, whatever is traced.
 
+use super::density::Density;
 use super::dots::{DotPattern, Lattice};
 use crate::rng::PhotonRng;
 use crate::rounding::{floor_i64, round_i64};
@@ -302,6 +303,80 @@ impl DotPattern {
     }
 }
 
+/// The squared dot radius of every column of a `lattice` pattern whose density varies
+/// along the axis only (a polynomial or a table; hex lattices: per column and row
+/// parity), computed once as [`DotPattern::covers`] computes it at every hit: the same
+/// numbers, without evaluating the density and the radius per hit. The tracer builds it
+/// per run ([`DotPattern::column_radii`]), so it always matches the pattern it traces.
+#[derive(Clone, Debug)]
+pub struct ColumnRadii {
+    /// Column of the first entry.
+    first: i64,
+    /// Entries per column: 1 (square) or 2 (hex, even and odd rows).
+    per_column: usize,
+    /// Squared radii, column-major.
+    r2: Vec<f64>,
+}
+
+/// Most columns a [`ColumnRadii`] holds (8 MB): beyond, the lookup computes per hit.
+const MAX_TABLED_COLUMNS: f64 = 1e6;
+
+impl ColumnRadii {
+    /// The squared radius of the dot of cell `(i, j)`. Columns beyond the table's ends
+    /// have the end's radius: the density is taken at the span's ends there.
+    fn get(&self, i: i64, j: i64) -> f64 {
+        let last = (self.r2.len() / self.per_column) as i64 - 1;
+        let col = (i - self.first).clamp(0, last) as usize;
+        let row = if self.per_column == 2 {
+            (j & 1) as usize
+        } else {
+            0
+        };
+        self.r2[col * self.per_column + row]
+    }
+}
+
+impl DotPattern {
+    /// The column table of this pattern, when it has one: `lattice` placement, a density
+    /// along the axis only, at most a million columns.
+    pub fn column_radii(&self) -> Option<ColumnRadii> {
+        let along_axis = !matches!(self.density, Density::Grid(_));
+        let columns = self.length / self.pitch;
+        // (NaN columns do not fit.)
+        let fits = columns <= MAX_TABLED_COLUMNS;
+        if !(self.placement == Placement::Lattice && along_axis && fits) {
+            return None;
+        }
+        // Two columns either side of the span: beyond them every cell centre lies off
+        // the span, where the density is the end's (graded_x clamps to the span).
+        let (first, last) = (-2, columns.ceil() as i64 + 2);
+        let per_column = match self.lattice {
+            Lattice::Square => 1,
+            Lattice::Hex => 2,
+        };
+        let r2 = (first..=last)
+            .flat_map(|i| (0..per_column as i64).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let density = self.density_at_point(self.cell_centre(i, j));
+                self.lattice.dot_radius_squared(self.pitch, density)
+            })
+            .collect();
+        Some(ColumnRadii {
+            first,
+            per_column,
+            r2,
+        })
+    }
+
+    /// [`DotPattern::covers`] for a pattern with a column table `radii` (from
+    /// [`DotPattern::column_radii`]): the same answer at every point.
+    pub fn covers_tabled(&self, p: DVec3, radii: &ColumnRadii) -> bool {
+        let q = self.face_coords(p);
+        let (i, j, c) = self.nearest_cell_centre(q);
+        q.distance_squared(c) < radii.get(i, j)
+    }
+}
+
 /// The dots of one bucket of the stochastic screen, drawn as they are asked for.
 struct BucketDots<'a> {
     pattern: &'a DotPattern,
@@ -363,6 +438,76 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The column table answers as the per-hit lookup does, everywhere on and off the
+    /// span, for both lattices, graded (polynomial, table; normalized, mm; mirrored) and
+    /// constant densities, and a pattern origin off the face's corner; patterns it cannot
+    /// hold get none.
+    #[test]
+    fn column_table_covers_as_the_lookup_does() {
+        use super::super::dots::{Density, XUnit};
+        let densities = [
+            (
+                Density::Polynomial(vec![0.05, 0.2, 0.4]),
+                XUnit::Normalized,
+                false,
+            ),
+            (
+                Density::Table(vec![[0.0, 0.1], [20.0, 0.7]]),
+                XUnit::Mm,
+                true,
+            ),
+            (Density::Polynomial(vec![0.2]), XUnit::Normalized, false),
+        ];
+        let mut g = PhotonRng::new(4, 9);
+        let mut inked = 0;
+        for lattice in [Lattice::Square, Lattice::Hex] {
+            for (density, x_unit, mirror) in densities.clone() {
+                let p = DotPattern {
+                    lattice,
+                    pitch: 0.37,
+                    origin: DVec3::new(-3.0, 1.0, 0.0),
+                    axis: DVec3::X,
+                    across: DVec3::Y,
+                    length: 41.3,
+                    density,
+                    x_unit,
+                    mirror,
+                    placement: Placement::Lattice,
+                    placement_seed: 0,
+                };
+                let radii = p.column_radii().expect("a lattice graded along its axis");
+                for _ in 0..50_000 {
+                    let x = 50.0 * g.uniform() - 7.0;
+                    let point = DVec3::new(x, 20.0 * g.uniform() - 10.0, 0.0);
+                    let want = p.covers(point);
+                    assert_eq!(p.covers_tabled(point, &radii), want, "{lattice:?} {point}");
+                    inked += usize::from(want);
+                }
+            }
+        }
+        assert!(inked > 10_000, "the points meet ink: {inked}");
+        let base = DotPattern {
+            lattice: Lattice::Square,
+            pitch: 0.5,
+            origin: DVec3::ZERO,
+            axis: DVec3::X,
+            across: DVec3::Y,
+            length: 10.0,
+            density: Density::Polynomial(vec![0.3]),
+            x_unit: XUnit::Normalized,
+            mirror: false,
+            placement: Placement::Jittered,
+            placement_seed: 0,
+        };
+        assert!(base.column_radii().is_none(), "jittered dots move");
+        let dense = DotPattern {
+            pitch: 1e-6,
+            placement: Placement::Lattice,
+            ..base
+        };
+        assert!(dense.column_radii().is_none(), "too many columns");
     }
 
     /// The lattice lookup agrees with a brute-force search for the nearest cell centre.

@@ -22,6 +22,7 @@ use super::{Photon, Tracer, absorb_clear, roulette};
 use crate::accel::convex::ConvexSolid;
 use crate::estimator::Estimator;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
+use crate::optics::dot_placement::ColumnRadii;
 use crate::optics::dots::DotPattern;
 use crate::optics::fresnel;
 use crate::optics::lambert;
@@ -33,14 +34,16 @@ use crate::tally::{ChunkTally, Fate, Ledger};
 use glam::DVec3;
 
 /// A tag's surface model as the walk takes it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(super) enum Face<'a> {
     /// A smooth dielectric face: its interface and the indices behind and in front.
     Smooth(Smooth),
-    /// A dotted face: ink where a dot is, else the smooth face.
+    /// A dotted face: ink where a dot is, else the smooth face. `radii`: the pattern's
+    /// column table, when it has one.
     Dotted {
         smooth: Smooth,
         pattern: &'a DotPattern,
+        radii: Option<ColumnRadii>,
         ink_albedo: f64,
     },
     /// Any other model, through [`SurfaceModel::interact_on`].
@@ -82,6 +85,7 @@ impl<'a> Walks<'a> {
                 } => Face::Dotted {
                     smooth: smooth(interface),
                     pattern,
+                    radii: pattern.column_radii(),
                     ink_albedo: *ink_albedo,
                 },
                 _ => Face::Other,
@@ -193,15 +197,20 @@ impl Tracer<'_> {
             outcome,
             feature: Feature::Plain,
         };
-        match self.walks.faces[tag as usize] {
+        match &self.walks.faces[tag as usize] {
             Face::Smooth(s) if !entering => plain(s.leave(surf.normal, dir, rng)),
             Face::Dotted {
                 smooth,
                 pattern,
+                radii,
                 ink_albedo,
             } if !entering => {
-                if pattern.meets_ink(surf.point, rng) {
-                    let outcome = ink(ink_albedo, -surf.normal, medium, self.estimator, rng);
+                let ink_met = match radii {
+                    Some(r) => pattern.covers_tabled(surf.point, r),
+                    None => pattern.meets_ink(surf.point, rng),
+                };
+                if ink_met {
+                    let outcome = ink(*ink_albedo, -surf.normal, medium, self.estimator, rng);
                     return Step {
                         outcome,
                         feature: Feature::Ink,

@@ -19,13 +19,8 @@ pub fn round_i64(x: f64) -> i64 {
     let t = x as i64;
     // Exact: `t` and `x` share their integer part, so the difference is `x`'s fraction.
     let frac = x - t as f64;
-    if frac >= 0.5 {
-        t + 1
-    } else if frac <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
+    // Flags, not branches: which way a hit's coordinate rounds is a coin toss.
+    t + i64::from(frac >= 0.5) - i64::from(frac <= -0.5)
 }
 
 #[cfg(test)]

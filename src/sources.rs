@@ -25,7 +25,7 @@
 //! ```
 //!
 //! Any entry may stand for a row of identical sources (`array = { count, pitch_mm,
-//! direction }`, see [`array`]).
+//! direction }`, see [`mod@array`]).
 //!
 //! An LED with `intensity_file` becomes an [`Emitter::MeasuredLed`]; see [`intensity`]
 //! for the CSV and IES LM-63 formats and how the table is sampled.
@@ -76,7 +76,7 @@ pub enum SourceSpec {
         /// What light returning to the tube meets ([`body`]).
         #[serde(default)]
         body: BodySpec,
-        /// A row of copies of this source ([`array`]).
+        /// A row of copies of this source ([`mod@array`]).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         array: Option<array::ArraySpec>,
     },
@@ -116,7 +116,7 @@ pub enum SourceSpec {
         /// is the rectangle itself.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         package_depth_mm: Option<f64>,
-        /// A row of copies of this source ([`array`]).
+        /// A row of copies of this source ([`mod@array`]).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         array: Option<array::ArraySpec>,
     },

@@ -9,7 +9,7 @@
 //!
 //! Each photon is traced along straight segments to the nearest surface, where its
 //! surface model decides by Russian roulette to reflect, transmit or absorb it; inside a
-//! scattering medium a segment may end earlier in a scattering event ([`flight`]). Both
+//! scattering medium a segment may end earlier in a scattering event (`flight`). Both
 //! kinds of event count as interactions and towards `max_bounces`. It ends in
 //! exactly one fate: detected, absorbed (by a named surface or medium), escaped, killed
 //! by the bounce cap, or (weighted estimator only) ended by Russian roulette. Work is split
@@ -39,19 +39,20 @@ const ROULETTE_BELOW: f64 = 0.1;
 /// ...and survives with probability `w / ROULETTE_SURVIVOR`, then carries this weight.
 const ROULETTE_SURVIVOR: f64 = 0.5;
 
-/// Traces photons of one scene through one backend.
+/// Traces photons of one scene through one backend (built by [`Tracer::new`], which
+/// derives the walks from the other fields, so they are fixed after it).
 pub struct Tracer<'a> {
     /// The scene.
-    pub scene: &'a Scene,
+    scene: &'a Scene,
     /// The intersection backend.
-    pub accel: &'a dyn Accel,
+    accel: &'a dyn Accel,
     /// How absorption is sampled.
-    pub estimator: Estimator,
+    estimator: Estimator,
     /// Use the convex-solid fast path inside convex media.
-    pub convex: bool,
+    convex: bool,
     /// The unit normal of every triangle of the scene's mesh
     /// ([`crate::geometry::Mesh::unit_normals`]).
-    pub normals: &'a [DVec3],
+    normals: &'a [DVec3],
     /// Where photons go face to face inside a convex solid ([`solid_walk`]).
     walks: Walks<'a>,
 }
@@ -104,7 +105,8 @@ impl<'a> Tracer<'a> {
         out.ledger.end(fate, p.weight);
     }
 
-    /// The photon loop: nearest event, the medium on the way, surface roulette, repeat.
+    /// The photon loop: nearest event, the medium on the way, surface roulette, repeat;
+    /// inside a walkable convex solid, face to face ([`solid_walk`]).
     fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
         let scene = self.scene;
         let mut events = 0;

@@ -170,7 +170,7 @@ pub fn initial_grid(
 
 /// Mean flux of the map's bins (of `scene`'s detector) nearest to each knot of `grid`
 /// (`[row][column]`); knots no bin is nearest to get their neighbours' mean
-/// ([`fill_empty_cells`]). Bins outside the pattern's span are left out.
+/// (`fill_empty_cells`). Bins outside the pattern's span are left out.
 pub fn measured_per_cell(
     scene: &Scene,
     pattern: &DotPattern,

@@ -1,7 +1,7 @@
 //! What each geometry file put into the scene, for `blutrace check`: triangles and
 //! bounding boxes in millimetres after all transforms, per file and per tag, and the
 //! placement warnings that catch unit and axis mistakes (a part 1000x too large or small,
-//! the detector plane cutting through a part; lamps cutting parts: [`super::lamp_placement`]).
+//! the detector plane cutting through a part; lamps cutting parts: `scene::lamp_placement`).
 
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh};

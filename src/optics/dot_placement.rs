@@ -153,18 +153,22 @@ impl DotPattern {
     /// [`DotPattern::nearest_cell`] and that cell's centre (one lookup per ink test).
     fn nearest_cell_centre(&self, q: DVec2) -> (i64, i64, DVec2) {
         let p = self.pitch;
+        // Reciprocals, not divisions by q's coordinates: they do not wait for the hit
+        // point, so only a multiplication stays on the hit's chain of dependent steps.
+        let per_pitch = 1.0 / p;
         match self.lattice {
             Lattice::Square => {
-                let (i, j) = (floor_i64(q.x / p), floor_i64(q.y / p));
+                let (i, j) = (floor_i64(q.x * per_pitch), floor_i64(q.y * per_pitch));
                 (i, j, self.cell_centre(i, j))
             }
             Lattice::Hex => {
                 // The two rows around q; in each, the column nearest q; the nearer wins
                 // (the first on a tie).
-                let j0 = floor_i64(q.y / self.row_spacing() - 0.5);
+                let per_row = 1.0 / self.row_spacing();
+                let j0 = floor_i64(q.y * per_row - 0.5);
                 let candidate = |j: i64| {
                     let shift = if j.rem_euclid(2) == 1 { 0.5 * p } else { 0.0 };
-                    let i = round_i64((q.x - shift) / p - 0.5);
+                    let i = round_i64((q.x - shift) * per_pitch - 0.5);
                     let c = self.cell_centre(i, j);
                     (i, j, c, c.distance_squared(q))
                 };

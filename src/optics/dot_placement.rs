@@ -322,7 +322,8 @@ pub struct ColumnRadii {
     r2: Vec<f64>,
 }
 
-/// Most columns a [`ColumnRadii`] holds (8 MB): beyond, the lookup computes per hit.
+/// Most columns a [`ColumnRadii`] holds (8 MB, 16 MB on a hex lattice): beyond, the lookup
+/// computes per hit.
 const MAX_TABLED_COLUMNS: f64 = 1e6;
 
 impl ColumnRadii {

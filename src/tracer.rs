@@ -68,6 +68,16 @@ struct Photon {
     absorption_depth: f64,
 }
 
+impl Photon {
+    /// Scale the weight by `factor` (a surface's albedo under the weighted estimator),
+    /// booking the loss to `sink`.
+    fn reweigh(&mut self, factor: f64, sink: &mut ExactSum) {
+        let w = self.weight * factor;
+        Ledger::lose(sink, self.weight, w);
+        self.weight = w;
+    }
+}
+
 impl<'a> Tracer<'a> {
     /// A tracer of `scene` through `accel`, with the triangles' unit `normals`
     /// ([`crate::geometry::Mesh::unit_normals`]); `convex` turns the convex-solid fast
@@ -159,9 +169,7 @@ impl<'a> Tracer<'a> {
                     medium,
                     weight,
                 } => {
-                    let w = p.weight * weight;
-                    Ledger::lose(struck.sink(&mut out.ledger), p.weight, w);
-                    p.weight = w;
+                    p.reweigh(weight, struck.sink(&mut out.ledger));
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                 }

@@ -3,7 +3,7 @@
 
 mod support;
 
-use blutrace::optics::dots::{Density, DensityGrid, DotPattern, Lattice, Placement, XUnit};
+use blutrace::optics::dots::{Density, DensityGrid, DotPattern, Lattice};
 use blutrace::optimize::export::{self, Dot};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -26,19 +26,7 @@ fn density_to_radius_for_square_and_hex_cells() {
 }
 
 fn pattern(lattice: Lattice, density: Density) -> DotPattern {
-    DotPattern {
-        lattice,
-        pitch: 0.5,
-        origin: DVec3::ZERO,
-        axis: DVec3::X,
-        across: DVec3::Y,
-        length: 30.0,
-        density,
-        x_unit: XUnit::Normalized,
-        mirror: false,
-        placement: Placement::Lattice,
-        placement_seed: 0,
-    }
+    support::dot_pattern(lattice, density, 30.0)
 }
 
 /// Two triangles covering x 0..30, y 0..12 at z = 0.

@@ -15,7 +15,7 @@
 mod support;
 
 use blutrace::estimator::Estimator;
-use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement, XUnit};
+use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement};
 use blutrace::optimize::export;
 use blutrace::rng::PhotonRng;
 use blutrace::run::{RunOptions, RunResult};
@@ -76,17 +76,9 @@ impl Books {
 /// A pattern on the plane z = 0 (face coordinates = x, y) with constant density.
 fn pattern(lattice: Lattice, placement: Placement, seed: u64, d: f64) -> DotPattern {
     DotPattern {
-        lattice,
-        pitch: 0.5,
-        origin: DVec3::ZERO,
-        axis: DVec3::X,
-        across: DVec3::Y,
-        length: 1000.0,
-        density: Density::Polynomial(vec![d]),
-        x_unit: XUnit::Normalized,
-        mirror: false,
         placement,
         placement_seed: seed,
+        ..support::dot_pattern(lattice, Density::Polynomial(vec![d]), 1000.0)
     }
 }
 

@@ -420,6 +420,7 @@ fn poisson(mean: f64, u: f64) -> u32 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::dots::test_pattern;
     use super::*;
 
     #[test]
@@ -470,17 +471,13 @@ mod tests {
         for lattice in [Lattice::Square, Lattice::Hex] {
             for (density, x_unit, mirror) in densities.clone() {
                 let p = DotPattern {
-                    lattice,
                     pitch: 0.37,
                     origin: DVec3::new(-3.0, 1.0, 0.0),
-                    axis: DVec3::X,
-                    across: DVec3::Y,
                     length: 41.3,
                     density,
                     x_unit,
                     mirror,
-                    placement: Placement::Lattice,
-                    placement_seed: 0,
+                    ..test_pattern(lattice, 0.0)
                 };
                 let radii = p.column_radii().expect("a lattice graded along its axis");
                 for _ in 0..50_000 {
@@ -494,17 +491,8 @@ mod tests {
         }
         assert!(inked > 10_000, "the points meet ink: {inked}");
         let base = DotPattern {
-            lattice: Lattice::Square,
-            pitch: 0.5,
-            origin: DVec3::ZERO,
-            axis: DVec3::X,
-            across: DVec3::Y,
-            length: 10.0,
-            density: Density::Polynomial(vec![0.3]),
-            x_unit: XUnit::Normalized,
-            mirror: false,
             placement: Placement::Jittered,
-            placement_seed: 0,
+            ..test_pattern(Lattice::Square, 0.3)
         };
         assert!(base.column_radii().is_none(), "jittered dots move");
         let dense = DotPattern {
@@ -518,20 +506,13 @@ mod tests {
     /// The lattice lookup agrees with a brute-force search for the nearest cell centre.
     #[test]
     fn lattice_lookup_finds_the_nearest_dot() {
-        use super::super::dots::{Density, XUnit};
+        use super::super::dots::Density;
         for lattice in [Lattice::Square, Lattice::Hex] {
             let p = DotPattern {
-                lattice,
                 pitch: 0.3,
-                origin: DVec3::ZERO,
-                axis: DVec3::X,
-                across: DVec3::Y,
                 length: 50.0,
                 density: Density::Polynomial(vec![0.1, 0.6]),
-                x_unit: XUnit::Normalized,
-                mirror: false,
-                placement: Placement::Lattice,
-                placement_seed: 0,
+                ..test_pattern(lattice, 0.0)
             };
             let mut g = PhotonRng::new(1, 2);
             for _ in 0..20_000 {

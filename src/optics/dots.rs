@@ -337,25 +337,28 @@ impl DotPattern {
     }
 }
 
+/// A lattice pattern for tests: pitch 0.5 mm on the plane z = 0 from the origin along x,
+/// 100 mm long, constant `density`.
+#[cfg(test)]
+pub(crate) fn test_pattern(lattice: Lattice, density: f64) -> DotPattern {
+    DotPattern {
+        lattice,
+        pitch: 0.5,
+        origin: DVec3::ZERO,
+        axis: DVec3::X,
+        across: DVec3::Y,
+        length: 100.0,
+        density: Density::Polynomial(vec![density]),
+        x_unit: XUnit::Normalized,
+        mirror: false,
+        placement: Placement::Lattice,
+        placement_seed: 0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn pattern(lattice: Lattice, density: f64) -> DotPattern {
-        DotPattern {
-            lattice,
-            pitch: 0.5,
-            origin: DVec3::ZERO,
-            axis: DVec3::X,
-            across: DVec3::Y,
-            length: 100.0,
-            density: Density::Polynomial(vec![density]),
-            x_unit: XUnit::Normalized,
-            mirror: false,
-            placement: Placement::Lattice,
-            placement_seed: 0,
-        }
-    }
 
     /// Stratified coverage over a patch equals the density (deterministic, so tight).
     fn coverage(p: &DotPattern) -> f64 {
@@ -375,7 +378,7 @@ mod tests {
     fn area_fraction_equals_density_square_and_hex() {
         for lattice in [Lattice::Square, Lattice::Hex] {
             for d in [0.05, 0.3, 0.7] {
-                let got = coverage(&pattern(lattice, d));
+                let got = coverage(&test_pattern(lattice, d));
                 assert!((got - d).abs() < 0.01, "{lattice:?} d={d}: covered {got}");
             }
         }
@@ -383,7 +386,7 @@ mod tests {
 
     #[test]
     fn mirror_measures_from_nearer_edge() {
-        let mut p = pattern(Lattice::Square, 0.0);
+        let mut p = test_pattern(Lattice::Square, 0.0);
         p.density = Density::Polynomial(vec![0.0, 1.0]);
         p.mirror = true;
         assert!((p.x_of(10.0) - 0.2).abs() < 1e-12);
@@ -407,7 +410,7 @@ mod tests {
         );
         assert!(Density::Table(vec![]).problem().is_some());
         assert!(Density::Polynomial(vec![f64::NAN]).problem().is_some());
-        let mut p = pattern(Lattice::Square, 0.0);
+        let mut p = test_pattern(Lattice::Square, 0.0);
         p.density = Density::Table(vec![[0.0, 0.05], [1.0, 0.65]]);
         let got = coverage(&p); // patch x 20..30 of 100: mean x = 0.25
         assert!((got - 0.2).abs() < 0.01, "covered {got}");
@@ -416,7 +419,7 @@ mod tests {
     #[test]
     fn cell_centres_are_lattice_points() {
         for lattice in [Lattice::Square, Lattice::Hex] {
-            let p = pattern(lattice, 0.3);
+            let p = test_pattern(lattice, 0.3);
             for (i, j) in [(0, 0), (3, 1), (-2, -3), (7, 4)] {
                 let c = p.cell_centre(i, j);
                 assert!(
@@ -466,7 +469,7 @@ mod tests {
 
     #[test]
     fn out_of_range_density_is_found() {
-        let mut p = pattern(Lattice::Square, 0.1);
+        let mut p = test_pattern(Lattice::Square, 0.1);
         assert_eq!(p.first_out_of_range(), None);
         p.density = Density::Polynomial(vec![0.1, 1.0]);
         let (u, d) = p.first_out_of_range().unwrap();

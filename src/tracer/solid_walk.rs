@@ -33,7 +33,7 @@ use crate::optics::medium::{Interface, MediumId};
 use crate::optics::surface::{Feature, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
-use crate::tally::{ChunkTally, Fate, Ledger};
+use crate::tally::{ChunkTally, Fate};
 use glam::DVec3;
 
 /// A tag's surface model as the walk takes it.
@@ -115,12 +115,6 @@ impl<'a> Walks<'a> {
     }
 }
 
-/// What one face did to the photon.
-struct Step {
-    outcome: Outcome,
-    feature: Feature,
-}
-
 impl Tracer<'_> {
     /// Follow `p` from face to face of `solid` until it leaves the solid's medium
     /// (`None`, `p` set up to go on in the general loop) or meets its fate, counting
@@ -154,23 +148,17 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: self.normals[h.prim as usize],
             };
-            let step = self.face_step(tag, &surf, ray.dir, medium, rng);
-            out.ledger.hit(tag, step.feature != Feature::Plain);
+            let (outcome, feature) = self.face_step(tag, &surf, ray.dir, medium, rng);
+            out.ledger.hit(tag, feature != Feature::Plain);
             let Outcome::Scattered {
                 dir,
                 medium: next,
                 weight,
-            } = step.outcome
+            } = outcome
             else {
                 return Some(Fate::AbsorbedBySurface(tag));
             };
-            let w = p.weight * weight;
-            Ledger::lose(
-                &mut out.ledger.absorbed_by_surface[tag as usize],
-                p.weight,
-                w,
-            );
-            p.weight = w;
+            p.reweigh(weight, &mut out.ledger.absorbed_by_surface[tag as usize]);
             ray = Ray::new(surf.point, dir);
             if !roulette(p, rng, &mut out.ledger) {
                 return Some(Fate::Roulette);
@@ -185,7 +173,8 @@ impl Tracer<'_> {
     }
 
     /// The face of tag `tag` met at `surf` along `dir` by a photon in `medium`: what
-    /// [`SurfaceModel::interact_on`] does, the guide's two faces taken directly.
+    /// [`SurfaceModel::interact_on`] does (and returns), the guide's two faces taken
+    /// directly.
     fn face_step(
         &self,
         tag: u32,
@@ -193,15 +182,11 @@ impl Tracer<'_> {
         dir: DVec3,
         medium: MediumId,
         rng: &mut PhotonRng,
-    ) -> Step {
+    ) -> (Outcome, Feature) {
         // As interact_on and dielectric::scatter decide it (NaN counts as leaving).
         let entering = dir.dot(surf.normal) < 0.0;
-        let plain = |outcome| Step {
-            outcome,
-            feature: Feature::Plain,
-        };
         match &self.walks.faces[tag as usize] {
-            Face::Smooth(s) if !entering => plain(s.leave(surf.normal, dir, rng)),
+            Face::Smooth(s) if !entering => (s.leave(surf.normal, dir, rng), Feature::Plain),
             Face::Dotted {
                 smooth,
                 pattern,
@@ -214,19 +199,18 @@ impl Tracer<'_> {
                 };
                 if ink_met {
                     let outcome = ink(*ink_albedo, -surf.normal, medium, self.estimator, rng);
-                    return Step {
-                        outcome,
-                        feature: Feature::Ink,
-                    };
+                    return (outcome, Feature::Ink);
                 }
-                plain(smooth.leave(surf.normal, dir, rng))
+                (smooth.leave(surf.normal, dir, rng), Feature::Plain)
             }
-            _ => {
-                let model = &self.scene.surfaces[tag as usize];
-                let (outcome, feature) =
-                    model.interact_on(&self.scene.media, surf, dir, medium, self.estimator, rng);
-                Step { outcome, feature }
-            }
+            _ => self.scene.surfaces[tag as usize].interact_on(
+                &self.scene.media,
+                surf,
+                dir,
+                medium,
+                self.estimator,
+                rng,
+            ),
         }
     }
 }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use blutrace::accel::BackendChoice;
+use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement, XUnit};
 use blutrace::run::{self, RunOptions, RunResult};
 use blutrace::scene::Scene;
 use std::fmt::Write;
@@ -242,4 +243,22 @@ pub fn bundled_scene_files() -> Vec<PathBuf> {
     );
     out.sort();
     out
+}
+
+/// A dot pattern on the plane z = 0 (face coordinates = x, y): pitch 0.5 mm, `length` mm
+/// along x from the origin, dots at the lattice points.
+pub fn dot_pattern(lattice: Lattice, density: Density, length: f64) -> DotPattern {
+    DotPattern {
+        lattice,
+        pitch: 0.5,
+        origin: glam::DVec3::ZERO,
+        axis: glam::DVec3::X,
+        across: glam::DVec3::Y,
+        length,
+        density,
+        x_unit: XUnit::Normalized,
+        mirror: false,
+        placement: Placement::Lattice,
+        placement_seed: 0,
+    }
 }

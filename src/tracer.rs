@@ -16,6 +16,7 @@
 //! into fixed chunks of photon indices; tallies are exact integer sums, so the result does
 //! not depend on the thread count.
 
+mod body_boxes;
 mod flight;
 mod solid_walk;
 
@@ -25,7 +26,9 @@ use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
+use crate::sources::body::LampBody;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
+use body_boxes::BodyBoxes;
 use flight::Flight;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -55,6 +58,8 @@ pub struct Tracer<'a> {
     normals: &'a [DVec3],
     /// Where photons go face to face inside a convex solid ([`solid_walk`]).
     walks: Walks<'a>,
+    /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
+    bodies: BodyBoxes,
 }
 
 /// A photon in flight.
@@ -96,6 +101,7 @@ impl<'a> Tracer<'a> {
             convex,
             normals,
             walks: Walks::new(scene, convex),
+            bodies: BodyBoxes::new(scene),
         }
     }
 
@@ -234,11 +240,8 @@ impl<'a> Tracer<'a> {
         // The search ray starts one spawn offset off the true position, so a body within
         // `t_max` of the true position lies within `t_max + eps` along the search ray.
         let reach = t_max + 2.0 * self.scene.spawn_eps;
-        for (i, source, body) in self.scene.sources.bodies() {
-            if source.medium != p.medium {
-                continue;
-            }
-            let Some(h) = body.hit(&p.ray.search, reach) else {
+        for i in self.bodies.near(p.medium, &p.ray.search, reach) {
+            let Some(h) = self.body(i).hit(&p.ray.search, reach) else {
                 continue;
             };
             let point = p.ray.search.at(h.t);
@@ -251,9 +254,9 @@ impl<'a> Tracer<'a> {
                     normal: h.normal,
                 };
                 let struck = if h.front {
-                    Struck::Body(i as u32)
+                    Struck::Body(i)
                 } else {
-                    Struck::BodyBack(i as u32)
+                    Struck::BodyBack(i)
                 };
                 best = Some(Hit { surf, struck });
             }
@@ -261,14 +264,17 @@ impl<'a> Tracer<'a> {
         best
     }
 
+    /// The body of source `i` (one that has a body).
+    fn body(&self, i: u32) -> &LampBody {
+        let body = self.scene.sources.list[i as usize].body.as_ref();
+        body.expect("only sources with bodies are listed")
+    }
+
     /// The surface model a photon meets.
     fn model(&self, struck: Struck) -> &SurfaceModel {
         match struck {
             Struck::Surface(tag) => &self.scene.surfaces[tag as usize],
-            Struck::Body(i) => {
-                let body = self.scene.sources.list[i as usize].body.as_ref();
-                &body.expect("only bodies are struck").model
-            }
+            Struck::Body(i) => &self.body(i).model,
             Struck::BodyBack(_) => &SurfaceModel::Absorber,
         }
     }

@@ -173,10 +173,19 @@ pub(super) fn source_cuts(
     let mut out = Vec::new();
     for s in sources {
         let grid = s.emitter.surface_grid(24);
+        // A triangle that cuts the emitter meets the grid's bounding box (a vertex inside
+        // the tube, or a point of the triangle between grid points on either side of it);
+        // the pad covers the grid's shortfall from the true surface between its points.
+        let (lo, hi) = bounds(grid.iter().map(|g| g.0), 0.0);
+        let (lo, hi) = (
+            lo - (hi - lo).max_element() * 0.1 - eps,
+            hi + (hi - lo).max_element() * 0.1 + eps,
+        );
         let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
         for (p, &tag) in mesh.tri_tag.iter().enumerate() {
             let c = mesh.corners(p as u32);
-            if hit.contains_key(&tag) {
+            let (tlo, thi) = bounds(c.into_iter(), 0.0);
+            if hit.contains_key(&tag) || tlo.cmpgt(hi).any() || thi.cmplt(lo).any() {
                 continue;
             }
             if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {

@@ -9,7 +9,7 @@
 //! starts a spawn offset off the surface it left (emitted photons included), so a photon
 //! leaving a body never meets that body again at distance ~0.
 
-use crate::geometry::Ray;
+use crate::geometry::{Aabb, Ray};
 use glam::DVec3;
 
 /// The shape of one lamp body.
@@ -81,6 +81,33 @@ impl BodyShape {
         (hit.t > 0.0 && hit.t < t_max).then_some(hit)
     }
 
+    /// An axis-aligned box holding the whole body: the tube's end discs swept along its
+    /// axis; the rectangle's corners, and for a package those corners moved `depth` back.
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            BodyShape::Cylinder {
+                center,
+                axis,
+                radius,
+                half_length,
+            } => {
+                // A disc of radius r across unit axis a reaches r sqrt(1 - a_i^2) along
+                // coordinate i.
+                let disc = (DVec3::ONE - *axis * *axis).max(DVec3::ZERO).powf(0.5) * *radius;
+                let reach = axis.abs() * *half_length + disc;
+                Aabb {
+                    min: *center - reach,
+                    max: *center + reach,
+                }
+            }
+            BodyShape::Rectangle(r) => Aabb::of(r.corners()),
+            BodyShape::Package { front, depth } => {
+                let back = front.normal * -*depth;
+                Aabb::of(front.corners().into_iter().flat_map(|c| [c, c + back]))
+            }
+        }
+    }
+
     /// Move the body by `d`.
     pub fn translate(&mut self, d: DVec3) {
         match self {
@@ -93,6 +120,12 @@ impl BodyShape {
 impl Rect {
     fn v(&self) -> DVec3 {
         self.normal.cross(self.u)
+    }
+
+    fn corners(&self) -> [DVec3; 4] {
+        let (u, v) = (self.u * self.half_width, self.v() * self.half_height);
+        let c = self.center;
+        [c - u - v, c + u - v, c + u + v, c - u + v]
     }
 
     /// True when `p` (on the rectangle's plane) lies within its edges.
@@ -426,5 +459,27 @@ mod tests {
             p.hit(&Ray::new(DVec3::new(-0.7, 0.0, 5.0), -DVec3::Z), 9.0),
             None
         );
+    }
+
+    #[test]
+    fn bounds_are_the_tightest_box() {
+        // A fine mesh of the tube has its vertices on the surface: inside the box, and
+        // reaching its faces to within the mesh's chord error.
+        let mesh = tube_mesh(4096);
+        let b = tube().bounds();
+        let fit = Aabb::of(mesh.positions.iter().copied());
+        assert!(fit.min.cmpge(b.min - 1e-12).all() && fit.max.cmple(b.max + 1e-12).all());
+        assert!((fit.min - b.min).max_element() < 1e-6, "{fit:?} {b:?}");
+        assert!((b.max - fit.max).max_element() < 1e-6, "{fit:?} {b:?}");
+        let r = led();
+        let p = BodyShape::Package {
+            front: r,
+            depth: 0.6,
+        };
+        let rect = BodyShape::Rectangle(r).bounds();
+        let want = (DVec3::new(0.0, -1.5, -0.2), DVec3::new(0.0, 1.5, 0.2));
+        assert_eq!((rect.min, rect.max), want);
+        let pb = p.bounds();
+        assert_eq!((pb.min, pb.max), (DVec3::new(-0.6, -1.5, -0.2), want.1));
     }
 }

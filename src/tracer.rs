@@ -34,6 +34,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 use solid_walk::Walks;
 
+/// The convex solid of `medium` when the convex path is on and the medium has one.
+fn convex_solid(scene: &Scene, convex: bool, medium: MediumId) -> Option<&ConvexSolid> {
+    scene.convex_solid(medium).filter(|_| convex)
+}
+
 /// Photons per work unit. Fixed, so results never depend on scheduling.
 pub const CHUNK: u64 = 4096;
 
@@ -94,14 +99,15 @@ impl<'a> Tracer<'a> {
         convex: bool,
         normals: &'a [DVec3],
     ) -> Tracer<'a> {
+        let bodies = BodyBoxes::new(scene);
         Tracer {
             scene,
             accel,
             estimator,
             convex,
             normals,
-            walks: Walks::new(scene, convex),
-            bodies: BodyBoxes::new(scene),
+            walks: Walks::new(scene, convex, &bodies),
+            bodies,
         }
     }
 
@@ -209,7 +215,7 @@ impl<'a> Tracer<'a> {
 
     /// The convex solid `p` travels in, when the fast path is on and its medium has one.
     fn convex_solid(&self, p: &Photon) -> Option<&ConvexSolid> {
-        self.scene.convex_solid(p.medium).filter(|_| self.convex)
+        convex_solid(self.scene, self.convex, p.medium)
     }
 
     /// The triangle `p` reaches first along `true_ray`.

@@ -36,6 +36,11 @@ impl BodyBoxes {
         Self { per_medium }
     }
 
+    /// True when a lamp body lies in `medium`.
+    pub(super) fn any_in(&self, medium: MediumId) -> bool {
+        !self.per_medium[medium as usize].is_empty()
+    }
+
     /// The sources whose bodies in `medium` the segment of `ray` from its origin to
     /// distance `reach` may meet: every body of the medium when `reach` is not finite.
     pub(super) fn near<'a>(

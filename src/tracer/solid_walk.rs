@@ -21,7 +21,8 @@
 //! Fresnel roulette called that way the walk was 15 % slower than the general loop; it
 //! and `Smooth::leave` are inlined.
 
-use super::{Photon, Tracer, absorb_clear, roulette};
+use super::body_boxes::BodyBoxes;
+use super::{Photon, Tracer, absorb_clear, convex_solid, roulette};
 use crate::accel::convex::ConvexSolid;
 use crate::estimator::Estimator;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
@@ -69,7 +70,7 @@ pub(super) struct Walks<'a> {
 
 impl<'a> Walks<'a> {
     /// The walks of `scene` (none when the convex path is off).
-    pub(super) fn new(scene: &'a Scene, convex: bool) -> Walks<'a> {
+    pub(super) fn new(scene: &'a Scene, convex: bool, bodies: &BodyBoxes) -> Walks<'a> {
         let n = |m: MediumId| scene.media[m as usize].n;
         let smooth = |iface: &Interface| Smooth {
             iface: *iface,
@@ -95,13 +96,9 @@ impl<'a> Walks<'a> {
             })
             .collect();
         let walkable = |m: usize| {
-            let solid = scene.convex_solid(m as MediumId).filter(|_| convex)?;
+            let solid = convex_solid(scene, convex, m as MediumId)?;
             let clear = solid.clear_of_target && scene.media[m].scattering.per_mm == 0.0;
-            let no_body = scene
-                .sources
-                .bodies()
-                .all(|(_, s, _)| s.medium as usize != m);
-            (clear && no_body).then_some(solid)
+            (clear && !bodies.any_in(m as MediumId)).then_some(solid)
         };
         Walks {
             faces,

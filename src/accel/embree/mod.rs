@@ -9,6 +9,7 @@
 //! | `RTCRay`    | 48   | org_xyz 0, tnear 12, dir_xyz 16, time 28, tfar 32, mask 36, id 40, flags 44 (align 16) |
 //! | `RTCHit`    | 48   | Ng_xyz 0, u 12, v 16, primID 20, geomID 24, instID\[1\] 28, instPrimID\[1\] 32 (align 16) |
 //! | `RTCRayHit` | 96   | ray 0, hit 48                                                         |
+//! | `RTCRayHitN` | 84 N | SoA packets of N = 4, 8, 16 rays ([`packet`]): `RTCRayN` then `RTCHitN`, every field an array of N lanes |
 //!
 //! `instPrimID` arrived with instance arrays in Embree 4.3 (`RTC_GEOMETRY_INSTANCE_ARRAY`,
 //! on in release builds); a 4.2-era declaration (`embree4-sys` 0.0.12: 80-byte
@@ -29,6 +30,11 @@
 //! off it, so the f32 test never re-hits the surface a ray leaves. The scene is built with
 //! `RTC_SCENE_FLAG_ROBUST` (watertight triangle test: no leaks through shared edges) and
 //! high build quality (scenes are built once and traced millions of times).
+//!
+//! [`EmbreeAccel::intersect_packet`] traces packets of 4, 8 or 16 rays
+//! (`rtcIntersect4/8/16`); `blutrace bench` measures whether they pay for photon rays.
+
+pub mod packet;
 
 use super::{Accel, Hit};
 use crate::geometry::{Mesh, Ray};
@@ -79,6 +85,9 @@ mod ffi {
     pub const RTC_DEVICE_PROPERTY_VERSION_MAJOR: c_uint = 1;
     pub const RTC_DEVICE_PROPERTY_VERSION_MINOR: c_uint = 2;
     pub const RTC_DEVICE_PROPERTY_VERSION_PATCH: c_uint = 3;
+    pub const RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED: c_uint = 32;
+    pub const RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED: c_uint = 33;
+    pub const RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED: c_uint = 34;
     pub const RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED: c_uint = 65;
     pub const RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED: c_uint = 96;
     // rtcore_device.h: enum RTCError
@@ -176,6 +185,10 @@ mod ffi {
     /// `rtcIntersect1(scene, rayhit, args)`; `args` (`RTCIntersectArguments*`) may be null.
     pub type Intersect1 = unsafe extern "C" fn(RTCScene, *mut RTCRayHit, args: *mut c_void);
     pub type ReleaseScene = unsafe extern "C" fn(RTCScene);
+    /// `rtcIntersect4/8/16(valid, scene, rayhit, args)`: `valid` (N `int`s, -1 active, 0
+    /// not) and `rayhit` (`RTCRayHitN*`) aligned to 4 N bytes; `args` may be null.
+    pub type IntersectN =
+        unsafe extern "C" fn(valid: *const i32, RTCScene, rayhit: *mut c_void, args: *mut c_void);
 
     /// `enum RTCError` names.
     pub(super) fn error_name(code: c_uint) -> &'static str {
@@ -214,6 +227,8 @@ struct Api {
     release_geometry: ReleaseGeometry,
     commit_scene: CommitScene,
     intersect1: Intersect1,
+    /// `rtcIntersect4`, `rtcIntersect8`, `rtcIntersect16`.
+    intersect_n: [IntersectN; 3],
     release_scene: ReleaseScene,
     _lib: Library,
 }
@@ -314,6 +329,11 @@ fn load_from(path: &Path) -> Result<Api> {
             release_geometry: symbol(&lib, "rtcReleaseGeometry")?,
             commit_scene: symbol(&lib, "rtcCommitScene")?,
             intersect1: symbol(&lib, "rtcIntersect1")?,
+            intersect_n: [
+                symbol(&lib, "rtcIntersect4")?,
+                symbol(&lib, "rtcIntersect8")?,
+                symbol(&lib, "rtcIntersect16")?,
+            ],
             release_scene: symbol(&lib, "rtcReleaseScene")?,
             _lib: lib,
         }

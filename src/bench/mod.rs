@@ -18,13 +18,16 @@
 //! (with and without the convex-solid fast path) it traces the same photons and reports
 //! rates and the ratio to obvhs. A second table times nearest-hit queries of rays inside
 //! the light guide alone: the convex path against each backend; a third, queries in the
-//! lamp cavities against the 540k-triangle mesh alone: the backends without the shared
-//! per-hit code. A last table gives the
-//! error reached in a fixed tracing time per backend and estimator, with the figure of
-//! merit `1 / (error^2 * seconds)`.
+//! lamp cavities against the 540k-triangle mesh alone ([`cavity`]): the backends without
+//! the shared per-hit code, and Embree's ray packets on emission and second-bounce rays.
+//! A last table gives the error reached in a fixed tracing time per backend and
+//! estimator, with the figure of merit `1 / (error^2 * seconds)`.
 
 pub mod box_scene;
+pub mod cavity;
 pub mod reference;
+
+pub use cavity::large_mesh_table;
 
 use crate::accel::{self, Accel, BackendChoice};
 use crate::geometry::Ray;
@@ -252,40 +255,6 @@ pub fn in_guide_table(
     Ok(names.zip(times).map(|(n, t)| (n, median(t))).collect())
 }
 
-/// Nearest-hit queries per second against the large scene (lamp reflectors split into
-/// 540k triangles) alone, for rays the lamps emit (into their reflector cavities): the
-/// backends themselves, without the shared per-hit code of whole photon paths. `repeat` rounds (medians). Returns (name, triangles, queries/s), obvhs first.
-pub fn large_mesh_table(
-    scene_dir: &Path,
-    queries: usize,
-    repeat: usize,
-) -> Result<Vec<(String, usize, f64)>> {
-    let mut scene = Scene::load(&scene_dir.join("scene.toml"))?;
-    scene.subdivide_tag("lamp_reflector", 5)?;
-    // The lamps' own emission: rays from the tubes into their reflector cavities.
-    let mut rng = PhotonRng::new(11, 0);
-    let rays: Vec<Ray> = (0..queries)
-        .map(|_| scene.sources.sample(&mut rng).ray)
-        .collect();
-    let accels: Vec<Box<dyn Accel>> = backends()
-        .into_iter()
-        .map(|b| accel::build(b, scene.mesh.clone()))
-        .collect::<Result<_>>()?;
-    let mut times: Vec<Vec<f64>> = vec![Vec::new(); accels.len()];
-    for _ in 0..repeat.max(1) {
-        for (a, accel) in accels.iter().enumerate() {
-            times[a].push(rate(&rays, |r| {
-                accel.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
-            }));
-        }
-    }
-    Ok(accels
-        .iter()
-        .zip(times)
-        .map(|(a, t)| (a.name().to_string(), scene.mesh.len(), median(t)))
-        .collect())
-}
-
 /// One row of the error-against-time table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ErrorRow {
@@ -392,8 +361,20 @@ mod tests {
             }
         }
         let large = large_mesh_table(&dir, 1000, 2).unwrap();
-        assert_eq!(large.len(), backends().len());
-        assert!(large.iter().all(|(_, n, q)| *n > 500_000 && *q > 0.0));
+        assert!(large.triangles > 500_000);
+        let per_set = if backends().len() > 1 { 5 } else { 1 };
+        assert_eq!(large.rows.len(), 2 * per_set);
+        assert_eq!(large.native_packets.is_some(), backends().len() > 1);
+        for set in large.rows.chunks(per_set) {
+            assert_eq!(
+                (set[0].method.as_str(), set[0].ratio_to_obvhs),
+                ("bvh", 1.0)
+            );
+            assert!(
+                set.iter()
+                    .all(|r| r.rays == set[0].rays && r.queries_per_s > 0.0)
+            );
+        }
         let queries = in_guide_table(&dir, 1000, 2).unwrap();
         assert_eq!(queries.len(), backends().len() + 1);
         assert_eq!(queries.last().unwrap().0, "convex");

@@ -1,0 +1,253 @@
+//! Nearest-hit queries in the lamp cavities of the large scene (notebook14 with its lamp
+//! reflectors split into about 540k triangles), against the mesh alone: the backends
+//! without the shared per-hit code of whole photon paths, one thread.
+//!
+//! Two ray sets of `queries` rays each: the lamps' own emission (rays from the tubes into
+//! their reflector cavities), and second-bounce rays (each emission ray's first hit,
+//! reflected diffusely with the tracer's Lambertian sampling from the side it came from),
+//! which is what most of a photon's queries look like. On each: obvhs and Embree one ray
+//! at a time, then Embree's packets of 8 (`rtcIntersect8`) on the rays in their own order
+//! (as a photon-by-photon tracer would hand them over: incoherent), and on the rays sorted
+//! by lamp, direction octant and position (the best case a wavefront tracer could arrange
+//! by sorting; the sort is not timed), with Embree one ray at a time on the same sorted
+//! rays beside it, to tell what the packets gain from what the order alone gains (cache).
+
+use super::{median, rate};
+use crate::accel::Accel;
+use crate::accel::bvh::ObvhsBvh;
+use crate::accel::embree::{self, EmbreeAccel, packet::NativePackets};
+use crate::geometry::{Aabb, Ray};
+use crate::optics::sampling;
+use crate::rng::PhotonRng;
+use crate::scene::Scene;
+use anyhow::Result;
+use std::path::Path;
+use std::time::Instant;
+
+/// One row of the lamp-cavity table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CavityRow {
+    /// The ray set: "emission" or "second bounce".
+    pub rays: &'static str,
+    /// Backend and how the rays were handed to it.
+    pub method: String,
+    /// Nearest-hit queries per second (median of the rounds).
+    pub queries_per_s: f64,
+    /// queries_per_s over obvhs's on the same rays.
+    pub ratio_to_obvhs: f64,
+}
+
+/// The lamp-cavity table and what it was measured on.
+#[derive(Clone, Debug)]
+pub struct CavityTable {
+    /// Triangles in the mesh.
+    pub triangles: usize,
+    /// The Embree packet widths traced natively here (`None` without Embree).
+    pub native_packets: Option<NativePackets>,
+    /// Per ray set: obvhs first, then the Embree rows.
+    pub rows: Vec<CavityRow>,
+}
+
+/// A ray and the lamp it came from.
+#[derive(Clone, Copy)]
+struct LampRay {
+    ray: Ray,
+    lamp: usize,
+}
+
+/// How a ray set is ordered and handed to a backend.
+#[derive(Clone, Copy, PartialEq)]
+enum Order {
+    /// As produced, photon after photon.
+    Produced,
+    /// Grouped by lamp and direction octant, then by position (Morton order).
+    Sorted,
+}
+
+/// The timed configurations: (label, order, packet of 8 or one ray at a time).
+const EMBREE_ROWS: [(&str, Order, bool); 4] = [
+    ("embree, one ray at a time", Order::Produced, false),
+    (
+        "embree, one ray at a time (sorted: by lamp, direction octant, position)",
+        Order::Sorted,
+        false,
+    ),
+    (
+        "embree, packets of 8 (incoherent: rays in the order produced)",
+        Order::Produced,
+        true,
+    ),
+    (
+        "embree, packets of 8 (sorted: by lamp, direction octant, position)",
+        Order::Sorted,
+        true,
+    ),
+];
+
+/// Queries per second on the large scene of `scene_dir`, for `queries` emission and as
+/// many second-bounce rays, `repeat` rounds (medians); each round times every row in turn.
+pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Result<CavityTable> {
+    let mut scene = Scene::load(&scene_dir.join("scene.toml"))?;
+    scene.subdivide_tag("lamp_reflector", 5)?;
+    let bvh = ObvhsBvh::new(scene.mesh.clone());
+    let embree = match embree::info() {
+        Ok(_) => Some(EmbreeAccel::new(scene.mesh.clone())?),
+        Err(_) => None,
+    };
+    let mut rng = PhotonRng::new(11, 0);
+    let emitted = emission(&scene, queries, &mut rng);
+    let scatter: &dyn Accel = embree.as_ref().map_or(&bvh, |e| e as &dyn Accel);
+    let bounced = second_bounce(&scene, scatter, &emitted, &mut rng);
+    let bounds = scene.mesh.bounds();
+    let mut rows = Vec::new();
+    for (label, set) in [("emission", &emitted), ("second bounce", &bounced)] {
+        let produced: Vec<Ray> = set.iter().map(|r| r.ray).collect();
+        let sorted = sorted(set, &bounds);
+        let mut times = vec![Vec::new(); 1 + EMBREE_ROWS.len()];
+        for _ in 0..repeat.max(1) {
+            times[0].push(rate(&produced, |r| {
+                bvh.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
+            }));
+            let Some(e) = &embree else { continue };
+            for (k, &(_, order, packets)) in EMBREE_ROWS.iter().enumerate() {
+                let rays = if order == Order::Sorted {
+                    &sorted
+                } else {
+                    &produced
+                };
+                times[k + 1].push(if packets {
+                    packet_rate(e, rays)
+                } else {
+                    rate(rays, |r| {
+                        e.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
+                    })
+                });
+            }
+        }
+        let names = std::iter::once("bvh").chain(EMBREE_ROWS.iter().map(|r| r.0));
+        let medians: Vec<f64> = times
+            .into_iter()
+            .filter(|t| !t.is_empty())
+            .map(median)
+            .collect();
+        for (name, q) in names.zip(&medians) {
+            rows.push(CavityRow {
+                rays: label,
+                method: name.into(),
+                queries_per_s: *q,
+                ratio_to_obvhs: q / medians[0],
+            });
+        }
+    }
+    Ok(CavityTable {
+        triangles: scene.mesh.len(),
+        native_packets: embree.as_ref().map(EmbreeAccel::native_packets),
+        rows,
+    })
+}
+
+/// `n` rays the lamps emit, each with the nearest lamp (by its centre).
+fn emission(scene: &Scene, n: usize, rng: &mut PhotonRng) -> Vec<LampRay> {
+    let anchors: Vec<_> = scene.sources.list.iter().map(|s| s.anchor()).collect();
+    (0..n)
+        .map(|_| {
+            let ray = scene.sources.sample(rng).ray;
+            let lamp = (0..anchors.len())
+                .min_by(|&a, &b| {
+                    let d = |i: usize| anchors[i].distance_squared(ray.origin);
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap_or(0);
+            LampRay { ray, lamp }
+        })
+        .collect()
+}
+
+/// Each hitting ray of `emitted`, reflected diffusely where it first meets the mesh (the
+/// paper's Lambertian direction around the normal facing it, spawned off the surface as
+/// the tracer does). Rays that miss the mesh are left out.
+fn second_bounce(
+    scene: &Scene,
+    accel: &dyn Accel,
+    emitted: &[LampRay],
+    rng: &mut PhotonRng,
+) -> Vec<LampRay> {
+    let mesh = &scene.mesh;
+    emitted
+        .iter()
+        .filter_map(|e| {
+            let hit = accel.intersect(&e.ray, f64::INFINITY)?;
+            let normal = mesh.normal(hit.prim);
+            let point = mesh.refine_hit(&e.ray, hit.prim, hit.t, normal).point;
+            let facing = if normal.dot(e.ray.dir) < 0.0 {
+                normal
+            } else {
+                -normal
+            };
+            let dir = sampling::lambertian(facing, rng.uniform(), rng.uniform());
+            let origin = scene.spawn_point(point, facing, dir);
+            Some(LampRay {
+                ray: Ray::new(origin, dir),
+                lamp: e.lamp,
+            })
+        })
+        .collect()
+}
+
+/// The rays grouped by lamp and direction octant, each group in Morton order of the
+/// origins (10 bits per axis over `bounds`).
+fn sorted(rays: &[LampRay], bounds: &Aabb) -> Vec<Ray> {
+    let size = (bounds.max - bounds.min).max(glam::DVec3::splat(1e-9));
+    let key = |r: &LampRay| {
+        let d = r.ray.dir;
+        let octant = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
+        let cell = ((r.ray.origin - bounds.min) / size * 1023.0)
+            .clamp(glam::DVec3::ZERO, glam::DVec3::splat(1023.0));
+        let morton = [cell.x, cell.y, cell.z]
+            .iter()
+            .enumerate()
+            .map(|(axis, &c)| spread_bits(c as u32) << axis)
+            .fold(0, |a, b| a | b);
+        (r.lamp, octant, morton)
+    };
+    let mut sorted = rays.to_vec();
+    sorted.sort_by_key(key);
+    sorted.into_iter().map(|r| r.ray).collect()
+}
+
+/// The low 10 bits of `v`, two zero bits after each (Morton interleaving).
+fn spread_bits(v: u32) -> u32 {
+    let mut x = v & 0x3ff;
+    x = (x | x << 16) & 0x0300_00ff;
+    x = (x | x << 8) & 0x0300_f00f;
+    x = (x | x << 4) & 0x030c_30c3;
+    (x | x << 2) & 0x0924_9249
+}
+
+/// Queries per second of `rtcIntersect8` over `rays`, eight at a time, single-threaded
+/// (packing the rays into the packet's layout included).
+fn packet_rate(e: &EmbreeAccel, rays: &[Ray]) -> f64 {
+    let queries: Vec<(Ray, f64)> = rays.iter().map(|&r| (r, f64::INFINITY)).collect();
+    let start = Instant::now();
+    let mut checksum = 0u64;
+    for chunk in queries.chunks(8) {
+        for h in e.intersect_packet::<8>(chunk).into_iter().flatten() {
+            checksum += u64::from(h.prim);
+        }
+    }
+    std::hint::black_box(checksum);
+    rays.len() as f64 / start.elapsed().as_secs_f64()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn morton_bits_interleave() {
+        assert_eq!(spread_bits(0b1), 0b1);
+        assert_eq!(spread_bits(0b11), 0b1001);
+        assert_eq!(spread_bits(0x3ff), 0x0924_9249);
+        assert_eq!(spread_bits(0x400), 0);
+    }
+}

@@ -64,6 +64,9 @@ enum Order {
     Sorted,
 }
 
+/// Rounds of this table at most (see [`large_mesh_table`]).
+const MAX_ROUNDS: usize = 3;
+
 /// The timed configurations: (label, order, packet of 8 or one ray at a time).
 const EMBREE_ROWS: [(&str, Order, bool); 4] = [
     ("embree, one ray at a time", Order::Produced, false),
@@ -84,8 +87,11 @@ const EMBREE_ROWS: [(&str, Order, bool); 4] = [
     ),
 ];
 
-/// Queries per second on the large scene of `scene_dir`, for `queries` emission and as
-/// many second-bounce rays, `repeat` rounds (medians); each round times every row in turn.
+/// Queries per second on the large scene of `scene_dir`, for `queries` emission rays and
+/// the second-bounce rays of those that hit, in `min(repeat, 3)` rounds (medians; each
+/// round times every row in turn). Three rounds: ten rows of a million queries each last
+/// a few seconds a round, long enough that a median of three is steady, and five would
+/// add half a minute to `blutrace bench`.
 pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Result<CavityTable> {
     let mut scene = Scene::load(&scene_dir.join("scene.toml"))?;
     scene.subdivide_tag("lamp_reflector", 5)?;
@@ -104,7 +110,7 @@ pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Resu
         let produced: Vec<Ray> = set.iter().map(|r| r.ray).collect();
         let sorted = sorted(set, &bounds);
         let mut times = vec![Vec::new(); 1 + EMBREE_ROWS.len()];
-        for _ in 0..repeat.max(1) {
+        for _ in 0..repeat.clamp(1, MAX_ROUNDS) {
             times[0].push(rate(&produced, |r| {
                 bvh.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
             }));

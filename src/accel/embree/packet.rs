@@ -13,8 +13,9 @@
 //! | `RTCRayHit8` | 672  | ray 0, hit 384                                                      |
 //!
 //! The `valid` mask is N `int`s (-1: trace this lane, 0: leave it untouched), aligned like
-//! the packet. Each lane is filled from, and read back into, the single-ray record
-//! ([`EmbreeAccel::intersect`]'s), so both paths convert rays and distances the same way.
+//! the packet. Each lane is filled from, and read back into, the single-ray record of
+//! `rtcIntersect1` ([`Accel::intersect`](super::Accel::intersect)), so both paths convert
+//! rays and distances the same way.
 //!
 //! Whether the library traces a width natively (one SIMD lane per ray) or splits it is
 //! `RTC_DEVICE_PROPERTY_NATIVE_RAY{4,8,16}_SUPPORTED`: a build without packet kernels
@@ -409,12 +410,12 @@ mod tests {
             unsafe { accel.intersect_packet_raw::<N>(&valid, &mut rh) };
             for i in 0..N {
                 let got = rh.get(i);
-                if !lanes.contains(&i) {
+                let Some((ray, tmax)) = chunk.get(i).filter(|_| lanes.contains(&i)) else {
                     // Untouched: still the empty record.
                     assert_eq!(bits(&got), bits(&RayHitN::<N>::empty().get(i)), "lane {i}");
                     continue;
-                }
-                let mut one = EmbreeAccel::ray_hit(&chunk[i].0, chunk[i].1);
+                };
+                let mut one = EmbreeAccel::ray_hit(ray, *tmax);
                 // SAFETY: a local, aligned, initialised record.
                 unsafe { accel.intersect_raw(&mut one) };
                 assert_eq!(bits(&got), bits(&one), "packet {c} lane {i} of {N}");

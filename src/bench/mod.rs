@@ -18,9 +18,9 @@
 //! (with and without the convex-solid fast path) it traces the same photons and reports
 //! rates and the ratio to obvhs. A second table times nearest-hit queries of rays inside
 //! the light guide alone: the convex path against each backend; a third, queries in the
-//! lamp cavities against the 540k-triangle mesh alone ([`cavity`]): the backends without
-//! the shared per-hit code, and Embree's ray packets on emission and second-bounce rays.
-//! A last table gives the error reached in a fixed tracing time per backend and
+//! lamp cavities against the 540k-triangle mesh alone ([`cavity`], at most 3 rounds): the
+//! backends without the shared per-hit code, and Embree's ray packets on emission and
+//! second-bounce rays. A last table gives the error reached in a fixed tracing time per backend and
 //! estimator, with the figure of merit `1 / (error^2 * seconds)`.
 
 pub mod box_scene;

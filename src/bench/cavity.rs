@@ -109,33 +109,8 @@ pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Resu
     for (label, set) in [("emission", &emitted), ("second bounce", &bounced)] {
         let produced: Vec<Ray> = set.iter().map(|r| r.ray).collect();
         let sorted = sorted(set, &bounds);
-        let mut times = vec![Vec::new(); 1 + EMBREE_ROWS.len()];
-        for _ in 0..repeat.clamp(1, MAX_ROUNDS) {
-            times[0].push(rate(&produced, |r| {
-                bvh.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
-            }));
-            let Some(e) = &embree else { continue };
-            for (k, &(_, order, packets)) in EMBREE_ROWS.iter().enumerate() {
-                let rays = if order == Order::Sorted {
-                    &sorted
-                } else {
-                    &produced
-                };
-                times[k + 1].push(if packets {
-                    packet_rate(e, rays)
-                } else {
-                    rate(rays, |r| {
-                        e.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
-                    })
-                });
-            }
-        }
+        let medians = medians(&bvh, embree.as_ref(), [&produced, &sorted], repeat);
         let names = std::iter::once("bvh").chain(EMBREE_ROWS.iter().map(|r| r.0));
-        let medians: Vec<f64> = times
-            .into_iter()
-            .filter(|t| !t.is_empty())
-            .map(median)
-            .collect();
         for (name, q) in names.zip(&medians) {
             rows.push(CavityRow {
                 rays: label,
@@ -150,6 +125,42 @@ pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Resu
         native_packets: embree.as_ref().map(EmbreeAccel::native_packets),
         rows,
     })
+}
+
+/// Median queries per second of obvhs on the rays as `produced`, then of each of
+/// [`EMBREE_ROWS`] when Embree is here, over `min(repeat, 3)` rounds.
+fn medians(
+    bvh: &ObvhsBvh,
+    embree: Option<&EmbreeAccel>,
+    [produced, sorted]: [&[Ray]; 2],
+    repeat: usize,
+) -> Vec<f64> {
+    let mut times = vec![Vec::new(); 1 + EMBREE_ROWS.len()];
+    for _ in 0..repeat.clamp(1, MAX_ROUNDS) {
+        times[0].push(rate(produced, |r| {
+            bvh.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
+        }));
+        let Some(e) = embree else { continue };
+        for (k, &(_, order, packets)) in EMBREE_ROWS.iter().enumerate() {
+            let rays = if order == Order::Sorted {
+                sorted
+            } else {
+                produced
+            };
+            times[k + 1].push(if packets {
+                packet_rate(e, rays)
+            } else {
+                rate(rays, |r| {
+                    e.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
+                })
+            });
+        }
+    }
+    times
+        .into_iter()
+        .filter(|t| !t.is_empty())
+        .map(median)
+        .collect()
 }
 
 /// `n` rays the lamps emit, each with the nearest lamp (by its centre).

@@ -10,7 +10,8 @@
 //! (as a photon-by-photon tracer would hand them over: incoherent), and on the rays sorted
 //! by lamp, direction octant and position (the best case a wavefront tracer could arrange
 //! by sorting; the sort is not timed), with Embree one ray at a time on the same sorted
-//! rays beside it, to tell what the packets gain from what the order alone gains (cache).
+//! rays beside it, to tell what the packets gain from what the order alone gains (cache),
+//! and obvhs on the sorted rays too: sorting helps both backends.
 
 use super::{median, rate};
 use crate::accel::Accel;
@@ -67,23 +68,37 @@ enum Order {
 /// Rounds of this table at most (see [`large_mesh_table`]).
 const MAX_ROUNDS: usize = 3;
 
-/// The timed configurations: (label, order, packet of 8 or one ray at a time).
-const EMBREE_ROWS: [(&str, Order, bool); 4] = [
-    ("embree, one ray at a time", Order::Produced, false),
+/// How a row queries: obvhs, Embree one ray at a time, or Embree's packets of 8.
+#[derive(Clone, Copy, PartialEq)]
+enum Query {
+    Bvh,
+    Embree,
+    EmbreePackets,
+}
+
+/// The timed configurations: (label, how, order). obvhs first: the ratios' reference.
+const ROWS: [(&str, Query, Order); 6] = [
+    ("bvh", Query::Bvh, Order::Produced),
+    (
+        "bvh (sorted: by lamp, direction octant, position)",
+        Query::Bvh,
+        Order::Sorted,
+    ),
+    ("embree, one ray at a time", Query::Embree, Order::Produced),
     (
         "embree, one ray at a time (sorted: by lamp, direction octant, position)",
+        Query::Embree,
         Order::Sorted,
-        false,
     ),
     (
         "embree, packets of 8 (incoherent: rays in the order produced)",
+        Query::EmbreePackets,
         Order::Produced,
-        true,
     ),
     (
         "embree, packets of 8 (sorted: by lamp, direction octant, position)",
+        Query::EmbreePackets,
         Order::Sorted,
-        true,
     ),
 ];
 
@@ -110,13 +125,12 @@ pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Resu
         let produced: Vec<Ray> = set.iter().map(|r| r.ray).collect();
         let sorted = sorted(set, &bounds);
         let medians = medians(&bvh, embree.as_ref(), [&produced, &sorted], repeat);
-        let names = std::iter::once("bvh").chain(EMBREE_ROWS.iter().map(|r| r.0));
-        for (name, q) in names.zip(&medians) {
+        for (name, q) in medians.iter() {
             rows.push(CavityRow {
                 rays: label,
-                method: name.into(),
+                method: (*name).into(),
                 queries_per_s: *q,
-                ratio_to_obvhs: q / medians[0],
+                ratio_to_obvhs: q / medians[0].1,
             });
         }
     }
@@ -127,39 +141,42 @@ pub fn large_mesh_table(scene_dir: &Path, queries: usize, repeat: usize) -> Resu
     })
 }
 
-/// Median queries per second of obvhs on the rays as `produced`, then of each of
-/// [`EMBREE_ROWS`] when Embree is here, over `min(repeat, 3)` rounds.
+/// Median queries per second of each of [`ROWS`] (the Embree rows when Embree is here)
+/// over `min(repeat, 3)` rounds, with the rows' labels.
 fn medians(
     bvh: &ObvhsBvh,
     embree: Option<&EmbreeAccel>,
     [produced, sorted]: [&[Ray]; 2],
     repeat: usize,
-) -> Vec<f64> {
-    let mut times = vec![Vec::new(); 1 + EMBREE_ROWS.len()];
+) -> Vec<(&'static str, f64)> {
+    let rows: Vec<_> = ROWS
+        .iter()
+        .filter(|r| r.1 == Query::Bvh || embree.is_some())
+        .collect();
+    let mut times = vec![Vec::new(); rows.len()];
     for _ in 0..repeat.clamp(1, MAX_ROUNDS) {
-        times[0].push(rate(produced, |r| {
-            bvh.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
-        }));
-        let Some(e) = embree else { continue };
-        for (k, &(_, order, packets)) in EMBREE_ROWS.iter().enumerate() {
+        for (k, &&(_, query, order)) in rows.iter().enumerate() {
             let rays = if order == Order::Sorted {
                 sorted
             } else {
                 produced
             };
-            times[k + 1].push(if packets {
-                packet_rate(e, rays)
-            } else {
+            let nearest = |a: &dyn Accel| {
                 rate(rays, |r| {
-                    e.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
+                    a.intersect(r, f64::INFINITY).map_or(0, |h| h.prim)
                 })
+            };
+            times[k].push(match (query, embree) {
+                (Query::EmbreePackets, Some(e)) => packet_rate(e, rays),
+                (Query::Embree, Some(e)) => nearest(e),
+                // Only the obvhs rows are kept without Embree.
+                _ => nearest(bvh),
             });
         }
     }
-    times
-        .into_iter()
-        .filter(|t| !t.is_empty())
-        .map(median)
+    rows.iter()
+        .zip(times)
+        .map(|(r, t)| (r.0, median(t)))
         .collect()
 }
 

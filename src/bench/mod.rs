@@ -362,7 +362,7 @@ mod tests {
         }
         let large = large_mesh_table(&dir, 1000, 2).unwrap();
         assert!(large.triangles > 500_000);
-        let per_set = if backends().len() > 1 { 5 } else { 1 };
+        let per_set = if backends().len() > 1 { 6 } else { 2 };
         assert_eq!(large.rows.len(), 2 * per_set);
         assert_eq!(large.native_packets.is_some(), backends().len() > 1);
         for set in large.rows.chunks(per_set) {

@@ -651,7 +651,8 @@ mod tests {
     use glam::DVec3;
 
     /// Like the integration tests: no Embree is a failure unless the machine opts out.
-    fn accel(mesh: Mesh) -> Option<EmbreeAccel> {
+    /// (Also the packet tests'.)
+    pub(super) fn accel(mesh: Mesh) -> Option<EmbreeAccel> {
         if std::env::var("BLUTRACE_SKIP_EMBREE").is_ok_and(|v| v == "1") {
             eprintln!("BLUTRACE_SKIP_EMBREE=1: Embree test skipped");
             return None;

@@ -311,20 +311,12 @@ impl EmbreeAccel {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::accel;
     use super::*;
     use crate::accel::Accel;
     use crate::geometry::Mesh;
     use crate::rng::PhotonRng;
     use glam::DVec3;
-    use std::sync::Arc;
-
-    fn accel(mesh: Mesh) -> Option<EmbreeAccel> {
-        if std::env::var("BLUTRACE_SKIP_EMBREE").is_ok_and(|v| v == "1") {
-            eprintln!("BLUTRACE_SKIP_EMBREE=1: Embree test skipped");
-            return None;
-        }
-        Some(EmbreeAccel::new(Arc::new(mesh)).unwrap_or_else(|e| panic!("{e:#}")))
-    }
 
     /// A closed, irregular mesh (a jittered sphere) whose hits have distinct normals, u, v
     /// and primIDs, so a lane or field out of place changes some record.

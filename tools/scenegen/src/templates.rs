@@ -143,6 +143,30 @@ pub fn phong(tag: &str, reflectance: f64, specular: f64, exponent: f64) -> Strin
     )
 }
 
+/// The white reflector sheet under the bundled CCFL and LED guides, with its comment: a
+/// `[surfaces.reflector_sheet]` Phong table.
+pub fn reflector_sheet() -> String {
+    "# White polyester (PET) reflector film. Reflectance 0.95: a round value just under the
+# over 96 % LCD reflector films are required to reflect (lcdpartscn.com, \"Reflector
+# film, reflective film\"). Its weak gloss (specular 0.1, exponent 10) is an assumption,
+# not a measurement.
+"
+    .to_string()
+        + &phong("reflector_sheet", 0.95, 0.1, 10.0)
+}
+
+/// The curved lamp reflector round the bundled CCFLs, with its comment: a
+/// `[surfaces.lamp_reflector]` Phong table.
+pub fn lamp_reflector() -> String {
+    "# Silver-coated lamp reflector film. Reflectance 0.95: an assumption below the over
+# 97 % of silver-coated LCD reflector films (lcdpartscn.com, \"Reflector film,
+# reflective film\"), for a film bent round the lamp; mostly specular (specular 0.8,
+# exponent 100), also an assumption.
+"
+    .to_string()
+        + &phong("lamp_reflector", 0.95, 0.8, 100.0)
+}
+
 /// A specular `[surfaces.TAG]` of reflectance `reflectance`.
 pub fn mirror(tag: &str, reflectance: f64) -> String {
     format!(

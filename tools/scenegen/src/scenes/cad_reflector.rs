@@ -21,8 +21,8 @@
 use super::GENERATED;
 use crate::shapes::{guide_box, sheet_up};
 use crate::templates::{
-    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
-    preamble, scene_file, trace_table,
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, lamp_reflector, medium,
+    obj_and_mtl, preamble, reflector_sheet, scene_file, trace_table,
 };
 use crate::{GenFile, P3, Part, dim, num, triangle_count};
 
@@ -169,8 +169,8 @@ Geometry: lgp.obj ({triangles} triangles) and {file}.
             front,
             edge,
             back,
-            phong("lamp_reflector", 0.95, 0.8, 100.0),
-            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            lamp_reflector(),
+            reflector_sheet(),
             Ccfl::new("lamp", c, LAMP_R, W).toml(),
             Detector::new([0.0, 0.0, T + DETECTOR_GAP], [L, W], [80, 60]).toml(),
             trace_table(400_000, 100_000),

@@ -4,8 +4,8 @@
 use super::GENERATED;
 use crate::shapes::guide_box;
 use crate::templates::{
-    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
-    preamble, scene_file, trace_table,
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, lamp_reflector, medium,
+    obj_and_mtl, preamble, reflector_sheet, scene_file, trace_table,
 };
 use crate::{GenFile, P3, Part, arr, num};
 
@@ -93,8 +93,8 @@ end_caps = true
             front,
             edge,
             back,
-            phong("lamp_reflector", 0.95, 0.8, 100.0),
-            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            lamp_reflector(),
+            reflector_sheet(),
             Ccfl::new("lamp", lamp, LAMP_R, sy - 1.0).toml(),
             Detector::new([2.0, 0.0, sz + 0.5], [sx - 2.0, sy], [49, 30]).toml(),
             trace_table(400_000, 100_000),

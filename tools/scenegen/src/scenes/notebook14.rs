@@ -4,8 +4,8 @@
 use super::GENERATED;
 use crate::shapes::{guide_box, sheet_up};
 use crate::templates::{
-    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, medium, obj_and_mtl, phong,
-    preamble, scene_file, trace_table,
+    Ccfl, Detector, Dots, MtlNote, dotted_guide_faces, geometry, lamp_reflector, medium,
+    obj_and_mtl, preamble, reflector_sheet, scene_file, trace_table,
 };
 use crate::{GenFile, LampHolder, P3, Part, dim, triangle_count};
 
@@ -163,8 +163,8 @@ Geometry: notebook14.obj (tags are its usemtl names), {triangles} triangles.
         medium("pmma", N_PMMA, ABSORPTION, None),
     ];
     tables.extend(dotted_guide_faces(&dots));
-    tables.push(phong("lamp_reflector", 0.95, 0.8, 100.0));
-    tables.push(phong("reflector_sheet", 0.95, 0.1, 10.0));
+    tables.push(lamp_reflector());
+    tables.push(reflector_sheet());
     for (name, c) in lamps() {
         let lamp = Ccfl {
             lumens: Some(300.0),

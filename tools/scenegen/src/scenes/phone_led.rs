@@ -10,7 +10,7 @@ use super::GENERATED;
 use crate::shapes::{guide_box, sheet_up};
 use crate::templates::{
     Detector, Dots, Led, MtlNote, absorber, dotted_guide_faces, geometry, medium, obj_and_mtl,
-    phong, preamble, scene_file, trace_table,
+    phong, preamble, reflector_sheet, scene_file, trace_table,
 };
 use crate::{GenFile, P3, Part, comment, dim, num, triangle_count};
 
@@ -287,7 +287,7 @@ Geometry: phone-led.obj (tags are its usemtl names), {triangles} triangles.
     ];
     tables.extend(dotted_guide_faces(&dots));
     tables.push(phong("led_housing", 0.9, 0.1, 10.0));
-    tables.push(phong("reflector_sheet", 0.95, 0.1, 10.0));
+    tables.push(reflector_sheet());
     tables.push(absorber("shield_tape"));
     for (i, c) in leds().iter().enumerate() {
         let name = format!("led{}", i + 1);

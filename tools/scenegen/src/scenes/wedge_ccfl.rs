@@ -3,8 +3,8 @@
 
 use super::GENERATED;
 use crate::templates::{
-    Ccfl, Detector, Dots, dotted_guide_faces, geometry, medium, phong, preamble, scene_file,
-    trace_table,
+    Ccfl, Detector, Dots, dotted_guide_faces, geometry, lamp_reflector, medium, preamble,
+    reflector_sheet, scene_file, trace_table,
 };
 use crate::{GenFile, LampHolder, P3, Part, dim, dims, hexahedron, triangle_count, write_gltf};
 
@@ -183,8 +183,8 @@ are world coordinates in millimetres, z up.
             front,
             edge,
             back,
-            phong("lamp_reflector", 0.95, 0.8, 100.0),
-            phong("reflector_sheet", 0.95, 0.1, 10.0),
+            lamp_reflector(),
+            reflector_sheet(),
             Ccfl::new("lamp", lamp, LAMP_R, W).toml(),
             Detector::new([0.0, 0.0, T0 + DETECTOR_GAP], [L, W], [100, 100]).toml(),
             trace_table(400_000, 100_000),

@@ -155,6 +155,32 @@ pub fn reflector_sheet() -> String {
         + &phong("reflector_sheet", 0.95, 0.1, 10.0)
 }
 
+/// Albedo of the bundled scenes' white PET films taken as Lambertian (see
+/// [`white_pet_lambert`]).
+pub const WHITE_PET_ALBEDO: f64 = 0.95;
+
+/// A white polyester (PET) film or white wall as a Lambertian `[surfaces.TAG]` of albedo
+/// [`WHITE_PET_ALBEDO`], with the source of that number.
+pub fn white_pet_lambert(tag: &str) -> String {
+    "# White polyester (PET) film, fully diffuse. Albedo 0.95: a round value just under the
+# over 96 % LCD reflector films are required to reflect (lcdpartscn.com, \"Reflector
+# film, reflective film\"); real white PET has a weak gloss this leaves out.
+"
+    .to_string()
+        + &lambert(tag, WHITE_PET_ALBEDO)
+}
+
+/// A silver-coated lamp reflector as a mirror `[surfaces.TAG]` of reflectance 0.95, with
+/// the source of that number.
+pub fn silver_mirror(tag: &str) -> String {
+    "# Silver-coated reflector film as a perfect mirror. Reflectance 0.95: an assumption
+# below the over 97 % of silver-coated LCD reflector films (lcdpartscn.com, \"Reflector
+# film, reflective film\"), for a film bent round the lamp.
+"
+    .to_string()
+        + &mirror(tag, 0.95)
+}
+
 /// The curved lamp reflector round the bundled CCFLs, with its comment: a
 /// `[surfaces.lamp_reflector]` Phong table.
 pub fn lamp_reflector() -> String {

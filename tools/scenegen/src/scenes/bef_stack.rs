@@ -7,8 +7,8 @@
 use super::GENERATED;
 use crate::shapes::{Facing, guide_box, lamp_box, sheet_up, solid_box};
 use crate::templates::{
-    Detector, Dots, Led, dielectric, dotted_guide_faces, geometry, lambert, medium, mirror,
-    preamble, rough_dielectric, scene_file, trace_table,
+    Detector, Dots, Led, dielectric, dotted_guide_faces, geometry, medium, preamble,
+    rough_dielectric, scene_file, silver_mirror, trace_table, white_pet_lambert,
 };
 use crate::{
     GenFile, ObjTags, P3, Part, arr, dim, dims, num, tags_of, triangle_count, write_mtl, write_obj,
@@ -191,8 +191,8 @@ Geometry: bef-stack.obj and bef-films.obj (usemtl names are tags), {triangles} t
         tables.push(medium(pet, N_PET, 0.0, None));
     }
     tables.extend(dotted_guide_faces(&dots));
-    tables.push(lambert("reflector_sheet", 0.95));
-    tables.push(mirror("lamp_reflector", 0.95));
+    tables.push(white_pet_lambert("reflector_sheet"));
+    tables.push(silver_mirror("lamp_reflector"));
     tables.push(rough_dielectric("diffuser_top", "pet_diffuser", ROUGHNESS));
     tables.push(dielectric("diffuser_back", "pet_diffuser"));
     tables.push(dielectric("diffuser_edge", "pet_diffuser"));

@@ -7,8 +7,8 @@
 use super::GENERATED;
 use crate::shapes::{Facing, guide_box, lamp_box, sheet_up};
 use crate::templates::{
-    Beads, Ccfl, Detector, MtlNote, bare_guide_faces, geometry, lambert, medium, obj_and_mtl,
-    preamble, scene_file, trace_table,
+    Beads, Ccfl, Detector, MtlNote, WHITE_PET_ALBEDO, bare_guide_faces, geometry, medium,
+    obj_and_mtl, preamble, scene_file, trace_table, white_pet_lambert,
 };
 use crate::{GenFile, P3, Part, dim, dims, num, triangle_count};
 
@@ -36,7 +36,7 @@ pub const CAVITY: f64 = 4.0;
 pub const LAMP_R: f64 = 1.0;
 /// Albedo of the white lamp cavity and reflector sheet (Lambertian, white PET; as the
 /// other bundled scenes' sheets).
-pub const WHITE_ALBEDO: f64 = 0.95;
+pub const WHITE_ALBEDO: f64 = WHITE_PET_ALBEDO;
 /// Gap between the guide's back face and the reflector sheet (mm).
 pub const SHEET_GAP: f64 = 0.2;
 /// Detector height above the front face (mm).
@@ -143,9 +143,9 @@ Geometry: diffusion-lgp.obj (usemtl names are tags), {triangles} triangles.
             front,
             back,
             edge,
-            lambert("lamp_cavity", WHITE_ALBEDO),
-            lambert("reflector_sheet", WHITE_ALBEDO),
-            lambert("edge_tape", WHITE_ALBEDO),
+            white_pet_lambert("lamp_cavity"),
+            white_pet_lambert("reflector_sheet"),
+            white_pet_lambert("edge_tape"),
             Ccfl::new("lamp", lamp(), LAMP_R, sy - 1.0).toml(),
             detector.toml(),
             trace_table(400_000, 100_000),

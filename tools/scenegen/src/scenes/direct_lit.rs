@@ -15,8 +15,8 @@
 use super::GENERATED;
 use crate::shapes::solid_box;
 use crate::templates::{
-    Beads, Ccfl, Detector, MtlNote, dielectric, geometry, lambert, medium, obj_and_mtl, preamble,
-    rough_dielectric, scene_file, trace_table,
+    Beads, Ccfl, Detector, MtlNote, WHITE_PET_ALBEDO, dielectric, geometry, medium, obj_and_mtl,
+    preamble, rough_dielectric, scene_file, trace_table, white_pet_lambert,
 };
 use crate::{GenFile, P3, Part, dim, num, triangle_count};
 
@@ -39,7 +39,7 @@ pub const LAMP_END_CLEARANCE: f64 = 5.0;
 /// Radiant power per lamp (W).
 pub const LAMP_POWER_W: f64 = 1.0;
 /// Albedo of the white box walls and back reflector (Lambertian).
-pub const WALL_ALBEDO: f64 = 0.95;
+pub const WALL_ALBEDO: f64 = WHITE_PET_ALBEDO;
 /// Detector height above the diffuser plate's top face (mm).
 pub const DETECTOR_GAP: f64 = 0.5;
 /// Default GGX roughness (alpha) of the diffuser plate's two large faces (rough plate).
@@ -353,7 +353,7 @@ Geometry: {obj} (tags are its usemtl names), {triangles} triangles.
         let [top, back] = top_and_back;
         vec![
             medium("pc", N_PLATE, PLATE_ABSORPTION, beads.as_ref()),
-            lambert("box_reflector", WALL_ALBEDO),
+            white_pet_lambert("box_reflector"),
             top,
             back,
             dielectric("diffuser_edge", "pc"),

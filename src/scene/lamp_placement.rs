@@ -176,11 +176,9 @@ pub(super) fn source_cuts(
         // A triangle that cuts the emitter meets the grid's bounding box (a vertex inside
         // the tube, or a point of the triangle between grid points on either side of it);
         // the pad covers the grid's shortfall from the true surface between its points.
-        let (lo, hi) = bounds(grid.iter().map(|g| g.0), 0.0);
-        let (lo, hi) = (
-            lo - (hi - lo).max_element() * 0.1 - eps,
-            hi + (hi - lo).max_element() * 0.1 + eps,
-        );
+        let reach = Aabb::of(grid.iter().map(|g| g.0));
+        let pad = 0.1 * (reach.max - reach.min).max_element() + eps;
+        let (lo, hi) = (reach.min - pad, reach.max + pad);
         let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
         for (p, &tag) in mesh.tri_tag.iter().enumerate() {
             let c = mesh.corners(p as u32);

@@ -93,7 +93,7 @@ impl BodyShape {
             } => {
                 // A disc of radius r across unit axis a reaches r sqrt(1 - a_i^2) along
                 // coordinate i.
-                let disc = (DVec3::ONE - *axis * *axis).max(DVec3::ZERO).powf(0.5) * *radius;
+                let disc = (DVec3::ONE - *axis * *axis).max(DVec3::ZERO).sqrt() * *radius;
                 let reach = axis.abs() * *half_length + disc;
                 Aabb {
                     min: *center - reach,

@@ -4,9 +4,11 @@
 //! is spared the exact tests of the other cavity's tubes.
 //!
 //! ```toml
-//! [[sources]]          # every source with a body ([`crate::sources::body`]) is listed
+//! [[sources]]          # every source whose body is not "transparent" is listed
+//! type = "ccfl"
 //! name = "left_upper"
-//! body = "lamp_glass"
+//! medium = "air"       # the medium whose segments are tested against it
+//! body = { model = "lambert", albedo = 0.5 }   # or "absorber" (the default)
 //! ```
 
 use crate::geometry::{Aabb, Ray};
@@ -126,7 +128,7 @@ mod tests {
             .unwrap();
         let body = scene.sources.list[left].body.as_ref().unwrap();
         let b = body.shape.bounds();
-        // From beside the tube's box, 1 mm towards its centre.
+        // From 0.5 mm outside the tube's box, a 1 mm segment into it.
         let from = DVec3::new(
             b.min.x - 0.5,
             0.5 * (b.min.y + b.max.y),

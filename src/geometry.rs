@@ -3,7 +3,7 @@
 //! All geometry is held in f64 millimetres. A scene is one [`Mesh`]: a vertex list, a
 //! triangle list and, per triangle, the index of its material tag. Acceleration backends
 //! may work in f32 internally, but the distance they report is refined here, in f64, on
-//! the primitive they found (see [`Mesh::refine_hit`]), so no backend decides physics.
+//! the primitive they found (see [`Facet::refine_hit`]), so no backend decides physics.
 
 use glam::DVec3;
 
@@ -76,19 +76,19 @@ impl SpawnedRay {
         Ray::new(self.from, self.search.dir)
     }
 
-    /// [`Mesh::refine_hit`] of the search ray's hit, but with distance and point measured
+    /// [`Facet::refine_hit`] of the search ray's hit, but with distance and point measured
     /// along the true path: the backend's triangle `prim`, at `t_backend` along the search
     /// ray. Where the true path meets the triangle's plane outside the triangle (the
     /// nudged ray went past an edge the true path does not), the nudged ray's point is
     /// kept: a point off the triangle could lie outside a closed solid and leak.
-    pub fn refine_hit(&self, mesh: &Mesh, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
+    pub fn refine_hit(&self, facet: &Facet, prim: u32, t_backend: f64) -> SurfaceHit {
         let (pos, ray) = (self.from, &self.search);
         let lead = (ray.origin - pos).length();
-        let exact = mesh.refine_hit(&Ray::new(pos, ray.dir), prim, t_backend + lead, normal);
-        if exact.t > lead && mesh.contains(prim, exact.point) {
+        let exact = facet.refine_hit(&Ray::new(pos, ray.dir), prim, t_backend + lead);
+        if exact.t > lead && facet.contains(exact.point) {
             return exact;
         }
-        let nudged = mesh.refine_hit(ray, prim, t_backend, normal);
+        let nudged = facet.refine_hit(ray, prim, t_backend);
         SurfaceHit {
             t: (nudged.point - pos).length(),
             ..nudged
@@ -125,6 +125,14 @@ impl Aabb {
         self.max = self.max.max(p);
     }
 
+    /// The box grown by `pad` on every side.
+    pub fn grown(&self, pad: f64) -> Aabb {
+        Aabb {
+            min: self.min - DVec3::splat(pad),
+            max: self.max + DVec3::splat(pad),
+        }
+    }
+
     /// True when nothing was added.
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x
@@ -137,6 +145,16 @@ impl Aabb {
         } else {
             self.min.abs().max(self.max.abs()).max_element()
         }
+    }
+
+    /// True when `ray` starts beyond one of the box's faces and does not turn back
+    /// towards it, so it cannot meet the box (a quick sufficient test: a ray that misses
+    /// the box otherwise, passing it by, is not caught). NaN coordinates compare false.
+    pub fn left_behind_by(&self, ray: &Ray) -> bool {
+        let zero = DVec3::ZERO;
+        let below = ray.origin.cmplt(self.min) & ray.dir.cmple(zero);
+        let above = ray.origin.cmpgt(self.max) & ray.dir.cmpge(zero);
+        (below | above).any()
     }
 
     /// Length of the diagonal (0 for an empty box).
@@ -218,11 +236,7 @@ impl Mesh {
     /// True when `p`, a point on the plane of triangle `prim`, lies inside it (edges
     /// included).
     pub fn contains(&self, prim: u32, p: DVec3) -> bool {
-        let [a, b, c] = self.corners(prim);
-        let n = (b - a).cross(c - a);
-        [(a, b), (b, c), (c, a)]
-            .iter()
-            .all(|&(u, v)| (v - u).cross(p - u).dot(n) >= 0.0)
+        in_triangle(self.corners(prim), p)
     }
 
     /// Exact (f64) intersection of `ray` with triangle `prim` within `(0, tmax)`.
@@ -230,11 +244,47 @@ impl Mesh {
         intersect_triangle(ray, self.corners(prim), tmax)
     }
 
-    /// Turn a backend's (distance, primitive) into a full hit, recomputing the distance
-    /// in f64 against the plane of triangle `prim` (unit `normal`, from
-    /// [`Mesh::unit_normals`]) so every backend yields the same point.
-    pub fn refine_hit(&self, ray: &Ray, prim: u32, t_backend: f64, normal: DVec3) -> SurfaceHit {
-        let a = self.positions[self.triangles[prim as usize][0] as usize];
+    /// What the shared refinement reads of triangle `prim` ([`Facet`]).
+    pub fn facet(&self, prim: u32) -> Facet {
+        Facet {
+            corners: self.corners(prim),
+            normal: self.normal(prim),
+            tag: self.tri_tag[prim as usize],
+        }
+    }
+
+    /// The [`Facet`] of every triangle, for a run to look up at every hit.
+    pub fn facets(&self) -> Vec<Facet> {
+        (0..self.len() as u32).map(|p| self.facet(p)).collect()
+    }
+}
+
+/// One triangle as a hit on it is refined and scored: its corners, unit geometric
+/// normal and tag, side by side. On a mesh too large for the cache a hit then costs one
+/// memory access (two adjacent lines) instead of a chain of them (vertex indices, then
+/// the vertices, the normal, the tag); that chain was most of the refinement's time on a
+/// 540k-triangle mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Facet {
+    /// The three corners ([`Mesh::corners`]).
+    pub corners: [DVec3; 3],
+    /// Unit geometric normal ([`Mesh::normal`]; zero for a degenerate triangle).
+    pub normal: DVec3,
+    /// The triangle's tag (index into the scene's tag list).
+    pub tag: u32,
+}
+
+impl Facet {
+    /// True when `p`, a point on the facet's plane, lies inside it (edges included).
+    pub fn contains(&self, p: DVec3) -> bool {
+        in_triangle(self.corners, p)
+    }
+
+    /// Turn a backend's hit on this facet (triangle `prim`, at `t_backend` along `ray`)
+    /// into a full hit, recomputing the distance in f64 against the facet's plane so
+    /// every backend yields the same point.
+    pub fn refine_hit(&self, ray: &Ray, prim: u32, t_backend: f64) -> SurfaceHit {
+        let (a, normal) = (self.corners[0], self.normal);
         let denom = normal.dot(ray.dir);
         let t_plane = if denom.abs() > 1e-300 {
             normal.dot(a - ray.origin) / denom
@@ -253,12 +303,15 @@ impl Mesh {
             normal,
         }
     }
+}
 
-    /// The unit normal of every triangle ([`Mesh::normal`]), for a run to look up
-    /// instead of recomputing at every hit.
-    pub fn unit_normals(&self) -> Vec<DVec3> {
-        (0..self.len() as u32).map(|p| self.normal(p)).collect()
-    }
+/// True when `p`, a point on the plane of the triangle with corners `[a, b, c]`, lies
+/// inside it (edges included).
+fn in_triangle([a, b, c]: [DVec3; 3], p: DVec3) -> bool {
+    let n = (b - a).cross(c - a);
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(u, v)| (v - u).cross(p - u).dot(n) >= 0.0)
 }
 
 /// The watertight ray/triangle test of Woop, Benthin & Wald (JCGT 2(1), 2013) in f64,
@@ -400,7 +453,7 @@ mod tests {
             from: pos,
             search: nudged,
         };
-        let hit = spawned.refine_hit(&mesh, 0, t, mesh.normal(0));
+        let hit = spawned.refine_hit(&mesh.facet(0), 0, t);
         assert!((hit.t - 1.0 / dir.z).abs() < 1e-12 && (hit.point.z - 1.0).abs() < 1e-12);
         assert!(mesh.contains(0, hit.point) && !mesh.contains(1, hit.point));
         // The true path meets the plane outside triangle 1: the nudged point is kept.
@@ -408,11 +461,8 @@ mod tests {
             from: DVec3::new(2.0, 0.1, 0.0),
             search: nudged,
         };
-        let far = far.refine_hit(&mesh, 1, t, mesh.normal(1));
-        assert_eq!(
-            far.point,
-            mesh.refine_hit(&nudged, 1, t, mesh.normal(1)).point
-        );
+        let far = far.refine_hit(&mesh.facet(1), 1, t);
+        assert_eq!(far.point, mesh.facet(1).refine_hit(&nudged, 1, t).point);
     }
 
     #[test]

@@ -22,7 +22,7 @@ mod solid_walk;
 
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
-use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
+use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
@@ -30,7 +30,6 @@ use crate::sources::body::LampBody;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
 use body_boxes::BodyBoxes;
 use flight::Flight;
-use glam::DVec3;
 use rayon::prelude::*;
 use solid_walk::Walks;
 
@@ -58,9 +57,9 @@ pub struct Tracer<'a> {
     estimator: Estimator,
     /// Use the convex-solid fast path inside convex media.
     convex: bool,
-    /// The unit normal of every triangle of the scene's mesh
-    /// ([`crate::geometry::Mesh::unit_normals`]).
-    normals: &'a [DVec3],
+    /// Every triangle of the scene's mesh as a hit on it reads it
+    /// ([`crate::geometry::Mesh::facets`]).
+    facets: &'a [Facet],
     /// Where photons go face to face inside a convex solid ([`solid_walk`]).
     walks: Walks<'a>,
     /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
@@ -89,15 +88,14 @@ impl Photon {
 }
 
 impl<'a> Tracer<'a> {
-    /// A tracer of `scene` through `accel`, with the triangles' unit `normals`
-    /// ([`crate::geometry::Mesh::unit_normals`]); `convex` turns the convex-solid fast
-    /// path on.
+    /// A tracer of `scene` through `accel`, with the mesh's `facets`
+    /// ([`crate::geometry::Mesh::facets`]); `convex` turns the convex-solid fast path on.
     pub fn new(
         scene: &'a Scene,
         accel: &'a dyn Accel,
         estimator: Estimator,
         convex: bool,
-        normals: &'a [DVec3],
+        facets: &'a [Facet],
     ) -> Tracer<'a> {
         let bodies = BodyBoxes::new(scene);
         Tracer {
@@ -105,7 +103,7 @@ impl<'a> Tracer<'a> {
             accel,
             estimator,
             convex,
-            normals,
+            facets,
             walks: Walks::new(scene, convex, &bodies),
             bodies,
         }
@@ -197,7 +195,7 @@ impl<'a> Tracer<'a> {
     /// true position).
     fn nearest_surface(&self, p: &Photon, true_ray: &Ray) -> Option<Hit> {
         let mesh = self.nearest_triangle(p, true_ray).map(|surf| Hit {
-            struck: Struck::Surface(self.scene.mesh.tri_tag[surf.prim as usize]),
+            struck: Struck::Surface(self.facets[surf.prim as usize].tag),
             surf,
         });
         let t_mesh = mesh.map_or(f64::INFINITY, |h| h.surf.t);
@@ -228,12 +226,12 @@ impl<'a> Tracer<'a> {
                 t: h.t,
                 prim: h.prim,
                 point: true_ray.at(h.t),
-                normal: self.normals[h.prim as usize],
+                normal: self.facets[h.prim as usize].normal,
             }),
-            None => self.accel.intersect(&p.ray.search, f64::INFINITY).map(|h| {
-                let n = self.normals[h.prim as usize];
-                p.ray.refine_hit(&scene.mesh, h.prim, h.t, n)
-            }),
+            None => self
+                .accel
+                .intersect(&p.ray.search, f64::INFINITY)
+                .map(|h| p.ray.refine_hit(&self.facets[h.prim as usize], h.prim, h.t)),
         }
     }
 

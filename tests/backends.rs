@@ -16,6 +16,7 @@
 
 use blutrace::accel::brute::BruteForce;
 use blutrace::accel::bvh::ObvhsBvh;
+use blutrace::accel::culled::Culled;
 use blutrace::accel::embree::EmbreeAccel;
 use blutrace::accel::{self, Accel, BackendChoice, Hit};
 use blutrace::geometry::{Mesh, Ray, orthonormal_basis, spawn_epsilon};
@@ -718,9 +719,7 @@ fn scene_queries(scene: &Scene, photons: u64, bounces: usize, seed: u64) -> Vec<
                 let Some(h) = oracle.intersect(&ray, f64::INFINITY) else {
                     break;
                 };
-                let s = scene
-                    .mesh
-                    .refine_hit(&ray, h.prim, h.t, scene.mesh.normal(h.prim));
+                let s = scene.mesh.facet(h.prim).refine_hit(&ray, h.prim, h.t);
                 let mut d = unit_sphere(&mut rng);
                 if d.dot(s.normal) == 0.0 {
                     d = s.normal;
@@ -732,6 +731,40 @@ fn scene_queries(scene: &Scene, photons: u64, bounces: usize, seed: u64) -> Vec<
             out
         })
         .collect()
+}
+
+/// Behind the mesh's box ([`Culled`]) every backend answers as it does alone, bit for
+/// bit, on the rays of the bundled scenes' photon paths and rays leaving their surfaces;
+/// and the box does spare queries (on bench-box, the rays leaving the guide's front face).
+#[test]
+fn culled_backends_answer_as_alone() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for path in scene_files(&root) {
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e:#}"));
+        let mesh = &scene.mesh;
+        let mut q = scene_queries(&scene, 500, 4, 11);
+        q.extend(queries(mesh, 3000, 12));
+        for alone in candidates(mesh) {
+            let name = alone.name();
+            let culled = Culled::new(alone, mesh);
+            let bare = culled.inner();
+            let spared = q.iter().filter(|(r, _)| culled.culls(r)).count();
+            for (r, tmax) in &q {
+                assert_eq!(
+                    culled.intersect(r, *tmax),
+                    bare.intersect(r, *tmax),
+                    "{name} {r:?}"
+                );
+            }
+            if path.ends_with("bench-box/scene.toml") {
+                assert!(
+                    spared > q.len() / 20,
+                    "{name}: {spared} of {} spared",
+                    q.len()
+                );
+            }
+        }
+    }
 }
 
 #[test]

@@ -34,8 +34,8 @@ fn queries(scene: &Scene, accel: &EmbreeAccel, n: usize) -> Vec<(Ray, f64)> {
         let ray = scene.sources.sample(&mut rng).ray;
         out.push((ray, f64::INFINITY));
         if let Some(hit) = accel.intersect(&ray, f64::INFINITY) {
-            let normal = mesh.normal(hit.prim);
-            let point = mesh.refine_hit(&ray, hit.prim, hit.t, normal).point;
+            let facet = mesh.facet(hit.prim);
+            let (normal, point) = (facet.normal, facet.refine_hit(&ray, hit.prim, hit.t).point);
             let facing = normal * -normal.dot(ray.dir).signum();
             let dir = sampling::lambertian(facing, rng.uniform(), rng.uniform());
             let bounce = Ray::new(scene.spawn_point(point, facing, dir), dir);

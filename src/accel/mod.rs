@@ -16,6 +16,7 @@
 pub mod brute;
 pub mod bvh;
 pub mod convex;
+pub mod culled;
 pub mod embree;
 
 use crate::geometry::{Mesh, Ray};
@@ -53,14 +54,17 @@ pub enum BackendChoice {
 }
 
 /// Build the backend `choice` over `mesh`. Call it inside the rayon pool that will trace:
-/// Embree sizes its thread pool from it.
+/// Embree sizes its thread pool from it. Every backend comes behind its mesh's box ([`culled::Culled`]).
 pub fn build(choice: BackendChoice, mesh: Arc<Mesh>) -> anyhow::Result<Box<dyn Accel>> {
-    Ok(match choice {
+    let inner: Box<dyn Accel> = match choice {
         // Only a library that cannot be loaded (or has the wrong version) means "no
         // Embree"; a failing build over a loaded library is an error worth reporting.
-        BackendChoice::Auto if embree::info().is_ok() => Box::new(embree::EmbreeAccel::new(mesh)?),
-        BackendChoice::Embree => Box::new(embree::EmbreeAccel::new(mesh)?),
-        BackendChoice::Auto | BackendChoice::Bvh => Box::new(bvh::ObvhsBvh::new(mesh)),
-        BackendChoice::Brute => Box::new(brute::BruteForce::new(mesh)),
-    })
+        BackendChoice::Auto if embree::info().is_ok() => {
+            Box::new(embree::EmbreeAccel::new(mesh.clone())?)
+        }
+        BackendChoice::Embree => Box::new(embree::EmbreeAccel::new(mesh.clone())?),
+        BackendChoice::Auto | BackendChoice::Bvh => Box::new(bvh::ObvhsBvh::new(mesh.clone())),
+        BackendChoice::Brute => Box::new(brute::BruteForce::new(mesh.clone())),
+    };
+    Ok(Box::new(culled::Culled::new(inner, &mesh)))
 }

@@ -211,8 +211,11 @@ fn second_bounce(
         .iter()
         .filter_map(|e| {
             let hit = accel.intersect(&e.ray, f64::INFINITY)?;
-            let normal = mesh.normal(hit.prim);
-            let point = mesh.refine_hit(&e.ray, hit.prim, hit.t, normal).point;
+            let facet = mesh.facet(hit.prim);
+            let (normal, point) = (
+                facet.normal,
+                facet.refine_hit(&e.ray, hit.prim, hit.t).point,
+            );
             let facing = if normal.dot(e.ray.dir) < 0.0 {
                 normal
             } else {

@@ -273,13 +273,13 @@ pub fn trace<'a>(
         .context("cannot start worker threads")?;
     let accel: Box<dyn Accel> =
         pool.install(|| accel::build(options.backend, scene.mesh.clone()))?;
-    let normals = scene.mesh.unit_normals();
+    let facets = scene.mesh.facets();
     let tracer = Tracer::new(
         scene,
         accel.as_ref(),
         options.estimator,
         options.convex,
-        &normals,
+        &facets,
     );
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();

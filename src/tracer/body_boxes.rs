@@ -14,7 +14,6 @@
 use crate::geometry::{Aabb, Ray};
 use crate::optics::surface::MediumId;
 use crate::scene::Scene;
-use glam::DVec3;
 
 /// Per medium: (source index, the body's box grown by the scene's spawn offset).
 pub(super) struct BodyBoxes {
@@ -26,13 +25,8 @@ impl BodyBoxes {
     /// that rounding in a hit point can never put it outside.
     pub(super) fn new(scene: &Scene) -> Self {
         let mut per_medium = vec![Vec::new(); scene.media.len()];
-        let pad = DVec3::splat(scene.spawn_eps);
         for (i, source, body) in scene.sources.bodies() {
-            let b = body.shape.bounds();
-            let grown = Aabb {
-                min: b.min - pad,
-                max: b.max + pad,
-            };
+            let grown = body.shape.bounds().grown(scene.spawn_eps);
             per_medium[source.medium as usize].push((i as u32, grown));
         }
         Self { per_medium }
@@ -72,6 +66,7 @@ mod tests {
     use crate::optics::surface::Estimator;
     use crate::tally::ChunkTally;
     use crate::tracer::Tracer;
+    use glam::DVec3;
 
     /// Chunks traced with the boxes and with every box the whole space (no body skipped)
     /// are the same bits: the boxes only skip bodies a segment cannot meet.
@@ -81,11 +76,11 @@ mod tests {
         for name in ["notebook14", "phone-led", "direct-lit"] {
             let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
             let accel = accel::build(BackendChoice::Bvh, scene.mesh.clone()).unwrap();
-            let normals = scene.mesh.unit_normals();
-            let boxed = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &normals);
+            let facets = scene.mesh.facets();
+            let boxed = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &facets);
             let all = BodyBoxes::new(&scene).per_medium.iter().flatten().count();
             assert!(all > 0, "{name}: no lamp bodies");
-            let mut open = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &normals);
+            let mut open = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &facets);
             let everywhere = Aabb {
                 min: DVec3::NEG_INFINITY,
                 max: DVec3::INFINITY,

@@ -138,12 +138,13 @@ impl Tracer<'_> {
             let Some(h) = exit else {
                 return Some(Fate::Escaped);
             };
-            let tag = scene.mesh.tri_tag[h.prim as usize];
+            let facet = &self.facets[h.prim as usize];
+            let tag = facet.tag;
             let surf = SurfaceHit {
                 t: h.t,
                 prim: h.prim,
                 point: ray.at(h.t),
-                normal: self.normals[h.prim as usize],
+                normal: facet.normal,
             };
             let (outcome, feature) = self.face_step(tag, &surf, ray.dir, medium, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
@@ -265,14 +266,14 @@ mod tests {
         for name in ["bench-box", "notebook14", "wedge-ccfl"] {
             let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
             let accel = accel::build(BackendChoice::Bvh, scene.mesh.clone()).unwrap();
-            let normals = scene.mesh.unit_normals();
+            let facets = scene.mesh.facets();
             for estimator in [Estimator::Analog, Estimator::Weighted] {
-                let walking = Tracer::new(&scene, accel.as_ref(), estimator, true, &normals);
+                let walking = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
                 assert!(
                     walking.walks.solids.iter().any(Option::is_some),
                     "{name}: nothing to walk"
                 );
-                let mut general = Tracer::new(&scene, accel.as_ref(), estimator, true, &normals);
+                let mut general = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
                 general.walks.solids.iter_mut().for_each(|s| *s = None);
                 let trace = |t: &Tracer, chunk| -> ChunkTally { t.trace_chunk(5, chunk, u64::MAX) };
                 for chunk in [0, 7] {

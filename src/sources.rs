@@ -318,6 +318,8 @@ pub struct Emission {
     pub normal: DVec3,
     /// The medium it starts in.
     pub medium: MediumId,
+    /// The index of the source that emitted it.
+    pub source: usize,
 }
 
 impl Source {
@@ -581,6 +583,7 @@ impl Sources {
             ray,
             normal,
             medium: s.medium,
+            source: i,
         }
     }
 

@@ -1,4 +1,5 @@
-//! The photon loop (paper section 3) and the parallel, deterministic driver around it.
+//! The photon loop (paper section 3), traced in fixed chunks of photons (the rounds that
+//! run them in parallel are `run::rounds`).
 //!
 //! ```toml
 //! [trace]
@@ -30,7 +31,6 @@ use crate::sources::body::LampBody;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
 use body_boxes::BodyBoxes;
 use flight::Flight;
-use rayon::prelude::*;
 use solid_walk::Walks;
 
 /// The convex solid of `medium` when the convex path is on and the medium has one.
@@ -314,8 +314,9 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// Trace chunk `index` (photons `index*CHUNK .. min(+CHUNK, end)`).
-    fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
+    /// Trace chunk `index` (photons `index*CHUNK .. min(+CHUNK, end)`) of the run seeded
+    /// `seed`: the same tally whichever thread traces it, and whenever.
+    pub fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
         let lo = index * CHUNK;
         let hi = (lo + CHUNK).min(end);
         let mut out = ChunkTally {
@@ -331,33 +332,6 @@ impl<'a> Tracer<'a> {
             self.trace_photon(seed, i, &mut out);
         }
         out
-    }
-
-    /// Trace photons `start..end` (`start` a multiple of [`CHUNK`]) in parallel and hand
-    /// every chunk's events to `sink`, in chunk order. `progress` is told how many photons
-    /// each finished chunk held. The result is identical for any thread count.
-    pub fn run_range(
-        &self,
-        seed: u64,
-        start: u64,
-        end: u64,
-        progress: &(dyn Fn(u64) + Sync),
-        sink: &mut dyn FnMut(&ChunkTally),
-    ) {
-        assert_eq!(start % CHUNK, 0, "ranges start on chunk boundaries");
-        let chunks: Vec<u64> = (start / CHUNK..end.div_ceil(CHUNK)).collect();
-        // Bounded batches keep memory flat however many photons a range holds.
-        for batch in chunks.chunks(256) {
-            let done: Vec<ChunkTally> = batch
-                .par_iter()
-                .map(|&c| {
-                    let t = self.trace_chunk(seed, c, end);
-                    progress(t.ledger.photons);
-                    t
-                })
-                .collect();
-            done.iter().for_each(&mut *sink);
-        }
     }
 }
 

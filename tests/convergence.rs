@@ -141,6 +141,44 @@ fn target_error_stops_at_or_below_the_target() {
     assert_balanced(&r);
 }
 
+/// Rounds are traced without waiting at their ends (workers run ahead into the next
+/// round; what they traced past a stopping round is dropped): a run stopped by its
+/// target error, on 1, 2 and 7 threads, stops after the same round with the same tallies
+/// and the same convergence history, bit for bit.
+#[test]
+fn rounds_and_their_history_do_not_depend_on_threads() {
+    let scene = plate_scene("rounds");
+    let run = |threads| {
+        let o = RunOptions {
+            photons: 50_000_000,
+            target_error: Some(0.004),
+            threads: Some(threads),
+            ..opts(0, 3)
+        };
+        trace_opts(&scene, &o)
+    };
+    let rows = |r: &blutrace::run::RunResult| -> Vec<String> {
+        let row = |h: &blutrace::run::ConvergenceRow| {
+            format!("{} {:?} {:?}", h.photons, h.values, h.stderr)
+        };
+        r.history.iter().map(row).collect()
+    };
+    let one = run(1);
+    assert_eq!(one.stopped_by, StoppedBy::TargetError);
+    assert!(one.history.len() >= 3, "{} rounds", one.history.len());
+    for threads in [2, 7] {
+        let other = run(threads);
+        assert_eq!(other.stopped_by, one.stopped_by, "{threads} threads");
+        assert_eq!(other.tally, one.tally, "{threads} threads");
+        assert_eq!(other.groups, one.groups, "{threads} threads");
+        assert_eq!(rows(&other), rows(&one), "{threads} threads");
+        assert_eq!(
+            format!("{:?}", other.leave_out),
+            format!("{:?}", one.leave_out)
+        );
+    }
+}
+
 #[test]
 fn photon_budget_stops_exactly() {
     let scene = plate_scene("budget");

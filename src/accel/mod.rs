@@ -2,7 +2,7 @@
 //!
 //! A backend answers one question: which triangle does this ray reach first, and how far
 //! away. Everything physical (the exact hit point, the normal, the surface model) is looked
-//! up afterwards in shared code ([`crate::geometry::Mesh::refine_hit`]), so backends cannot
+//! up afterwards in shared code ([`crate::geometry::Facet::refine_hit`]), so backends cannot
 //! disagree on physics. [`brute::BruteForce`] is the test oracle.
 //!
 //! ```toml

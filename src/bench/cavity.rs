@@ -180,19 +180,15 @@ fn medians(
         .collect()
 }
 
-/// `n` rays the lamps emit, each with the nearest lamp (by its centre).
+/// `n` rays the lamps emit, each with the lamp that emitted it.
 fn emission(scene: &Scene, n: usize, rng: &mut PhotonRng) -> Vec<LampRay> {
-    let anchors: Vec<_> = scene.sources.list.iter().map(|s| s.anchor()).collect();
     (0..n)
         .map(|_| {
-            let ray = scene.sources.sample(rng).ray;
-            let lamp = (0..anchors.len())
-                .min_by(|&a, &b| {
-                    let d = |i: usize| anchors[i].distance_squared(ray.origin);
-                    d(a).total_cmp(&d(b))
-                })
-                .unwrap_or(0);
-            LampRay { ray, lamp }
+            let e = scene.sources.sample(rng);
+            LampRay {
+                ray: e.ray,
+                lamp: e.source,
+            }
         })
         .collect()
 }

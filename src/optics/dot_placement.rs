@@ -316,6 +316,8 @@ impl DotPattern {
 pub struct ColumnRadii {
     /// Column of the first entry.
     first: i64,
+    /// Index of the last entry's column, counted from `first`.
+    last: i64,
     /// Entries per column: 1 (square) or 2 (hex, even and odd rows).
     per_column: usize,
     /// Squared radii, column-major.
@@ -330,8 +332,7 @@ impl ColumnRadii {
     /// The squared radius of the dot of cell `(i, j)`. Columns beyond the table's ends
     /// have the end's radius: the density is taken at the span's ends there.
     fn get(&self, i: i64, j: i64) -> f64 {
-        let last = (self.r2.len() / self.per_column) as i64 - 1;
-        let col = (i - self.first).clamp(0, last) as usize;
+        let col = (i - self.first).clamp(0, self.last) as usize;
         let row = if self.per_column == 2 {
             (j & 1) as usize
         } else {
@@ -368,6 +369,7 @@ impl DotPattern {
             .collect();
         Some(ColumnRadii {
             first,
+            last: last - first,
             per_column,
             r2,
         })

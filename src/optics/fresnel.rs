@@ -14,9 +14,6 @@ use glam::DVec3;
 /// into index `n2`, with `cos_i` the cosine of the incidence angle (in `[0, 1]`).
 /// Returns 1 beyond the critical angle (total internal reflection).
 pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
-    if n1 == n2 {
-        return 0.0; // no interface, at every angle including grazing
-    }
     let cos_i = cos_i.clamp(0.0, 1.0);
     match cos_transmitted(cos_i, n1, n2) {
         None => 1.0,
@@ -28,22 +25,24 @@ pub fn reflectance(cos_i: f64, n1: f64, n2: f64) -> f64 {
 /// `cos_i` (in `[0, 1]`).
 fn reflectance_with(cos_i: f64, cos_t: f64, n1: f64, n2: f64) -> f64 {
     if n1 == n2 {
-        return 0.0;
+        return 0.0; // no interface, at every angle including grazing
     }
     let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
     let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
     0.5 * (rs * rs + rp * rp)
 }
 
-/// Cosine of the refraction angle by Snell's law, or `None` under total internal reflection.
+/// Cosine of the refraction angle by Snell's law, or `None` under total internal reflection
+/// (beyond the critical angle; at it the cosine is 0, where [`reflectance`] is 1).
 ///
 /// `cos_t^2 = 1 - eta^2 (1 - cos_i^2)` is evaluated as `(1 - eta)(1 + eta) + eta^2 cos_i^2`:
 /// the same number, without the cancellation of `1 - sin_t^2` at grazing incidence (at
-/// eta = 1 it is exactly `cos_i^2`, so an index-matched interface never bends a ray).
+/// eta = 1 it is exactly `cos_i^2`, so an index-matched interface never bends a ray, nor
+/// reflects one, even at grazing incidence).
 pub fn cos_transmitted(cos_i: f64, n1: f64, n2: f64) -> Option<f64> {
     let eta = n1 / n2;
     let cos2_t = (1.0 - eta) * (1.0 + eta) + eta * eta * (cos_i * cos_i).min(1.0);
-    (cos2_t > 0.0).then(|| cos2_t.sqrt())
+    (cos2_t >= 0.0).then(|| cos2_t.sqrt())
 }
 
 /// The critical angle (radians) going from `n1` into `n2 < n1`; `None` when `n2 >= n1`.
@@ -125,6 +124,24 @@ mod tests {
             let cos_i = k as f64 / 100.0;
             assert_eq!(reflectance(cos_i, 1.3, 1.3), 0.0);
         }
+        // The roulette agrees, at grazing incidence too: the photon goes straight on.
+        let mut rng = PhotonRng::new(1, 2);
+        for dir in [DVec3::X, DVec3::new(0.6, 0.0, -0.8)] {
+            assert_eq!(roulette(dir, DVec3::Z, 1.3, 1.3, &mut rng), Some(dir));
+        }
+    }
+
+    #[test]
+    fn the_critical_angle_itself_reflects_everything() {
+        // Where Snell's cosine is exactly 0 the reflectance is exactly 1: the roulette
+        // reflects without a draw, as beyond the critical angle.
+        let (n1, n2, cos_i) = (1.25, 1.0, 0.6); // sin_i = 0.8 = n2/n1, and in f64 too
+        assert_eq!(cos_transmitted(cos_i, n1, n2), Some(0.0));
+        assert_eq!(reflectance(cos_i, n1, n2), 1.0);
+        let dir = DVec3::new(0.8, 0.0, cos_i);
+        let (mut rng, mut fresh) = (PhotonRng::new(1, 2), PhotonRng::new(1, 2));
+        assert_eq!(roulette(dir, DVec3::NEG_Z, n1, n2, &mut rng), None);
+        assert_eq!(rng.uniform(), fresh.uniform());
     }
 
     #[test]

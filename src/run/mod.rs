@@ -21,6 +21,7 @@
 
 mod images;
 pub mod metrics;
+mod rounds;
 pub mod summary;
 
 use crate::accel::{self, Accel, BackendChoice};
@@ -33,11 +34,10 @@ use crate::scene::Scene;
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
-use metrics::{BinSet, GROUPS, Map, Metric, MetricValues, ScoredBins};
-use rayon::prelude::*;
+use metrics::{GROUPS, Map, Metric, MetricValues};
+use rounds::Rounds;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 /// The metric a `--target-error` refers to.
@@ -283,15 +283,7 @@ pub fn trace<'a>(
     );
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();
-    let stopped_by = loop {
-        if let Some(why) = state.stop_reason(options, start.elapsed().as_secs_f64()) {
-            break why;
-        }
-        let end = state.next_round_end(options, start.elapsed().as_secs_f64());
-        pool.install(|| state.trace_round(&tracer, options.seed, end, progress));
-        let seconds = start.elapsed().as_secs_f64();
-        pool.install(|| state.record(scene, seconds));
-    };
+    let stopped_by = state.run(&pool, &tracer, scene, options, start, progress);
     Ok(RunResult {
         scene,
         backend: accel.name(),
@@ -304,121 +296,6 @@ pub fn trace<'a>(
         history: state.history,
         leave_out: state.leave_out,
     })
-}
-
-/// Photons per round unit: one chunk for every group.
-const ROUND_UNIT: u64 = CHUNK * GROUPS as u64;
-
-/// The state of a run between rounds.
-struct Rounds {
-    first: u64,
-    last: u64,
-    traced: u64,
-    total: Tally,
-    groups: Vec<Tally>,
-    /// The flux bins each group has scored in (for the jackknife).
-    scored: ScoredBins,
-    history: Vec<ConvergenceRow>,
-    /// The metrics with each group left out, after the last round.
-    leave_out: Vec<MetricValues>,
-}
-
-impl Rounds {
-    fn new(scene: &Scene, (first, last): (u64, u64)) -> Self {
-        Self {
-            first,
-            last,
-            traced: first,
-            total: Tally::new(scene),
-            groups: vec![Tally::new(scene); GROUPS],
-            scored: ScoredBins::new(GROUPS, scene.detector.bins[0] * scene.detector.bins[1]),
-            history: Vec::new(),
-            leave_out: Vec::new(),
-        }
-    }
-
-    /// Trace photons `traced..end` on the current rayon pool. Every chunk is scored into
-    /// its group and the total by the worker that traced it, as soon as it is traced,
-    /// under a lock per tally (the group's is rarely contended: consecutive chunks go to
-    /// different groups), so no worker waits for a serial merge. The sums are integers,
-    /// so the order in which chunks arrive does not matter.
-    fn trace_round(
-        &mut self,
-        tracer: &Tracer,
-        seed: u64,
-        end: u64,
-        progress: &(dyn Fn(u64) + Sync),
-    ) {
-        let groups: Vec<Mutex<(&mut Tally, &mut BinSet)>> = self
-            .groups
-            .iter_mut()
-            .zip(self.scored.sets_mut())
-            .map(Mutex::new)
-            .collect();
-        let total = Mutex::new(&mut self.total);
-        (self.traced / CHUNK..end.div_ceil(CHUNK))
-            .into_par_iter()
-            .for_each(|c| {
-                let last = ((c + 1) * CHUNK).min(end);
-                tracer.run_range(seed, c * CHUNK, last, progress, &mut |chunk| {
-                    let scored = chunk.scored();
-                    {
-                        let mut group = lock(&groups[(chunk.index % GROUPS as u64) as usize]);
-                        let (tally, bins) = &mut *group;
-                        tally.absorb_scored(chunk, &scored);
-                        chunk.detections.iter().for_each(|d| bins.mark(d.flux_bin));
-                    }
-                    lock(&total).absorb_scored(chunk, &scored);
-                })
-            });
-        self.traced = end;
-    }
-
-    fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
-        if self.traced >= self.last {
-            return Some(StoppedBy::Photons);
-        }
-        if let (Some(target), Some(row)) = (o.target_error, self.history.last()) {
-            let m = o.target_metric.metric();
-            let rel = relative_error(m, row.values[m], row.stderr[m]);
-            if rel <= target {
-                return Some(StoppedBy::TargetError);
-            }
-        }
-        match o.max_time_s {
-            Some(t) if elapsed >= t => Some(StoppedBy::Time),
-            _ => None,
-        }
-    }
-
-    /// Rounds grow geometrically (x1.5), in whole round units, so history points are
-    /// evenly spaced on log axes; a round is shrunk to fit the remaining time budget.
-    fn next_round_end(&self, o: &RunOptions, elapsed: f64) -> u64 {
-        let done = self.traced - self.first;
-        let mut size = (done / 2).max(ROUND_UNIT).div_ceil(ROUND_UNIT) * ROUND_UNIT;
-        if let (Some(limit), true) = (o.max_time_s, done > 0 && elapsed > 0.0) {
-            let rate = done as f64 / elapsed;
-            let fits = ((limit - elapsed) * rate) as u64 / ROUND_UNIT * ROUND_UNIT;
-            size = size.min(fits.max(ROUND_UNIT));
-        }
-        (self.traced + size).min(self.last)
-    }
-
-    fn record(&mut self, scene: &Scene, seconds: f64) {
-        let e = metrics::estimates(scene, &self.total, &self.groups, &self.scored);
-        self.history.push(ConvergenceRow {
-            photons: self.traced,
-            seconds,
-            values: e.values,
-            stderr: e.stderr,
-        });
-        self.leave_out = e.leave_out;
-    }
-}
-
-/// Lock `m`; a worker that panicked while holding it has already failed the run.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Relative standard error of a metric (the per-bin metric is already relative).

@@ -26,8 +26,9 @@
 //! 3. the system's `libembree4.so.4` (the dynamic loader's search path).
 //!
 //! Embree works in f32: the distance it reports is refined in f64 by the shared code
-//! ([`Facet::refine_hit`]), and rays leaving a surface start [`crate::geometry::spawn_epsilon`]
-//! off it, so the f32 test never re-hits the surface a ray leaves. The scene is built with
+//! ([`crate::geometry::Facet::refine_hit`]), and rays leaving a surface start
+//! [`crate::geometry::spawn_epsilon`] off it, so the f32 test never re-hits the surface a
+//! ray leaves. The scene is built with
 //! `RTC_SCENE_FLAG_ROBUST` (watertight triangle test: no leaks through shared edges) and
 //! high build quality (scenes are built once and traced millions of times).
 //!

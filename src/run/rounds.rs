@@ -1,0 +1,285 @@
+//! Tracing in rounds without waiting at their ends.
+//!
+//! ```text
+//! blutrace trace SCENE [--photons N] [--target-error E] [--max-time S] [--threads T]
+//! ```
+//!
+//! A run's photons go in rounds (growing 1.5x, in whole round units of [`GROUPS`] chunks);
+//! after each, the metrics and their errors become a row of the convergence history and
+//! the stopping rules are asked. The workers never wait for that: each takes the next
+//! chunk in index order and sends what it traced to the calling thread, which absorbs the
+//! chunks of the current round, holds those of the next, and takes the round's row as
+//! soon as its last chunk arrives, while the workers trace on. Workers may run at most
+//! one round unit past the current round's end (the next round is at least that long),
+//! so when a rule stops the run the chunks traced beyond its last round (a few, at most a
+//! round unit) are dropped, and the tallies hold exactly the rounds' photons. Every chunk
+//! is the same whichever worker traced it and the sums are integers, so results do not
+//! depend on the thread count; without the wait, a round's end no longer leaves all but
+//! one worker idle (with many threads, most of them).
+
+use super::metrics::{self, GROUPS, MetricValues, ScoredBins};
+use super::{ConvergenceRow, RunOptions, StoppedBy, relative_error};
+use crate::scene::Scene;
+use crate::tally::{ChunkTally, Tally};
+use crate::tracer::{CHUNK, Tracer};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Condvar, Mutex};
+use std::time::Instant;
+
+/// Photons per round unit: one chunk for every group.
+const ROUND_UNIT: u64 = CHUNK * GROUPS as u64;
+
+/// The state of a run between rounds.
+pub(super) struct Rounds {
+    first: u64,
+    last: u64,
+    /// Photons absorbed: the end of the last recorded round.
+    pub(super) traced: u64,
+    pub(super) total: Tally,
+    pub(super) groups: Vec<Tally>,
+    /// The flux bins each group has scored in (for the jackknife).
+    scored: ScoredBins,
+    pub(super) history: Vec<ConvergenceRow>,
+    /// The metrics with each group left out, after the last round.
+    pub(super) leave_out: Vec<MetricValues>,
+}
+
+/// What a run's workers share: the next chunk to take, how far they may go, and whether
+/// to stop.
+struct Gate {
+    next: AtomicU64,
+    /// Chunks below this index may be traced.
+    limit: AtomicU64,
+    stop: AtomicBool,
+    wait: Mutex<()>,
+    moved: Condvar,
+}
+
+impl Gate {
+    /// The next chunk below `end` to trace, once the limit allows it; None when there
+    /// is none or the run stopped.
+    fn take(&self, end: u64) -> Option<u64> {
+        let c = self.next.fetch_add(1, Ordering::Relaxed);
+        if c >= end {
+            return None;
+        }
+        if c < self.limit.load(Ordering::Acquire) && !self.stopped() {
+            return Some(c);
+        }
+        let mut guard = lock(&self.wait);
+        while c >= self.limit.load(Ordering::Acquire) && !self.stopped() {
+            guard = self.moved.wait(guard).unwrap_or_else(|e| e.into_inner());
+        }
+        (!self.stopped()).then_some(c)
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Acquire)
+    }
+
+    /// Let chunks below `limit` be traced.
+    fn raise(&self, limit: u64) {
+        self.limit.store(limit, Ordering::Release);
+        self.wake();
+    }
+
+    /// Stop the workers after the chunks they are tracing.
+    fn halt(&self) {
+        self.stop.store(true, Ordering::Release);
+        self.wake();
+    }
+
+    fn wake(&self) {
+        // Under the lock, so no worker is between its check and its wait.
+        let _guard = lock(&self.wait);
+        self.moved.notify_all();
+    }
+}
+
+/// Halts the gate when its thread unwinds: a worker's panic stops the others instead of
+/// leaving the calling thread waiting for its chunk, and the calling thread's stops the
+/// workers the scope would otherwise wait for (the run then fails with the panic).
+struct HaltOnPanic<'a>(&'a Gate);
+
+impl Drop for HaltOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.halt();
+        }
+    }
+}
+
+impl Rounds {
+    /// Nothing traced yet of the photons `first..last` of `scene`.
+    pub(super) fn new(scene: &Scene, (first, last): (u64, u64)) -> Self {
+        Self {
+            first,
+            last,
+            traced: first,
+            total: Tally::new(scene),
+            groups: vec![Tally::new(scene); GROUPS],
+            scored: ScoredBins::new(GROUPS, scene.detector.bins[0] * scene.detector.bins[1]),
+            history: Vec::new(),
+            leave_out: Vec::new(),
+        }
+    }
+
+    /// Trace rounds on `pool`'s workers until a stopping rule of `o` holds (time counted
+    /// from `start`); `progress` is told the photons of each chunk absorbed.
+    pub(super) fn run(
+        &mut self,
+        pool: &rayon::ThreadPool,
+        tracer: &Tracer,
+        scene: &Scene,
+        o: &RunOptions,
+        start: Instant,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> StoppedBy {
+        if let Some(why) = self.stop_reason(o, start.elapsed().as_secs_f64()) {
+            return why;
+        }
+        let end = self.next_round_end(o, start.elapsed().as_secs_f64());
+        let gate = Gate {
+            next: AtomicU64::new(self.traced / CHUNK),
+            limit: AtomicU64::new(end.div_ceil(CHUNK) + GROUPS as u64),
+            stop: AtomicBool::new(false),
+            wait: Mutex::new(()),
+            moved: Condvar::new(),
+        };
+        let (last, seed) = (self.last, o.seed);
+        let (tx, rx) = channel();
+        pool.in_place_scope(|s| {
+            for _ in 0..pool.current_num_threads() {
+                let (gate, tx) = (&gate, tx.clone());
+                s.spawn(move |_| work(gate, tracer, seed, last, tx));
+            }
+            drop(tx);
+            let _halt = HaltOnPanic(&gate);
+            let why = self.absorb_rounds(pool, scene, o, start, end, &gate, &rx, progress);
+            gate.halt();
+            why
+        })
+    }
+
+    /// The calling thread's part of [`Rounds::run`]: absorb chunks as they arrive, record
+    /// each round as it completes, until a rule stops the run.
+    #[allow(clippy::too_many_arguments)]
+    fn absorb_rounds(
+        &mut self,
+        pool: &rayon::ThreadPool,
+        scene: &Scene,
+        o: &RunOptions,
+        start: Instant,
+        mut end: u64,
+        gate: &Gate,
+        rx: &Receiver<ChunkTally>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> StoppedBy {
+        let mut ahead: Vec<ChunkTally> = Vec::new();
+        let mut missing = end.div_ceil(CHUNK) - self.traced / CHUNK;
+        loop {
+            while missing == 0 {
+                self.traced = end;
+                let seconds = start.elapsed().as_secs_f64();
+                if end == self.last {
+                    // No chunk is left to trace: the workers are free to share the
+                    // jackknife (asking them earlier would wait for their chunks).
+                    pool.install(|| self.record(scene, seconds));
+                } else {
+                    self.record(scene, seconds);
+                }
+                if let Some(why) = self.stop_reason(o, seconds) {
+                    return why;
+                }
+                end = self.next_round_end(o, seconds);
+                let end_chunk = end.div_ceil(CHUNK);
+                gate.raise(end_chunk + GROUPS as u64);
+                missing = end_chunk - self.traced / CHUNK;
+                let (now, later) = ahead.drain(..).partition(|c| c.index < end_chunk);
+                ahead = later;
+                for chunk in now {
+                    self.absorb(&chunk, progress);
+                    missing -= 1;
+                }
+            }
+            // Every worker gone with chunks missing: one panicked, and the scope
+            // re-raises its panic once this one unwinds.
+            let chunk = rx.recv().expect("a worker ended without its chunk");
+            if chunk.index < end.div_ceil(CHUNK) {
+                self.absorb(&chunk, progress);
+                missing -= 1;
+            } else {
+                ahead.push(chunk);
+            }
+        }
+    }
+
+    /// Score a traced chunk into its group and the total.
+    fn absorb(&mut self, chunk: &ChunkTally, progress: &(dyn Fn(u64) + Sync)) {
+        let scored = chunk.scored();
+        let g = (chunk.index % GROUPS as u64) as usize;
+        self.groups[g].absorb_scored(chunk, &scored);
+        let bins = &mut self.scored.sets_mut()[g];
+        chunk.detections.iter().for_each(|d| bins.mark(d.flux_bin));
+        self.total.absorb_scored(chunk, &scored);
+        progress(chunk.ledger.photons);
+    }
+
+    fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
+        if self.traced >= self.last {
+            return Some(StoppedBy::Photons);
+        }
+        if let (Some(target), Some(row)) = (o.target_error, self.history.last()) {
+            let m = o.target_metric.metric();
+            let rel = relative_error(m, row.values[m], row.stderr[m]);
+            if rel <= target {
+                return Some(StoppedBy::TargetError);
+            }
+        }
+        match o.max_time_s {
+            Some(t) if elapsed >= t => Some(StoppedBy::Time),
+            _ => None,
+        }
+    }
+
+    /// Rounds grow geometrically (x1.5), in whole round units, so history points are
+    /// evenly spaced on log axes; a round is shrunk to fit the remaining time budget.
+    fn next_round_end(&self, o: &RunOptions, elapsed: f64) -> u64 {
+        let done = self.traced - self.first;
+        let mut size = (done / 2).max(ROUND_UNIT).div_ceil(ROUND_UNIT) * ROUND_UNIT;
+        if let (Some(limit), true) = (o.max_time_s, done > 0 && elapsed > 0.0) {
+            let rate = done as f64 / elapsed;
+            let fits = ((limit - elapsed) * rate) as u64 / ROUND_UNIT * ROUND_UNIT;
+            size = size.min(fits.max(ROUND_UNIT));
+        }
+        (self.traced + size).min(self.last)
+    }
+
+    fn record(&mut self, scene: &Scene, seconds: f64) {
+        let e = metrics::estimates(scene, &self.total, &self.groups, &self.scored);
+        self.history.push(ConvergenceRow {
+            photons: self.traced,
+            seconds,
+            values: e.values,
+            stderr: e.stderr,
+        });
+        self.leave_out = e.leave_out;
+    }
+}
+
+/// A worker: trace chunks `gate` hands out (photons below `last`) and send them on, until
+/// there are none or the run stops.
+fn work(gate: &Gate, tracer: &Tracer, seed: u64, last: u64, tx: Sender<ChunkTally>) {
+    let _halt = HaltOnPanic(gate);
+    while let Some(c) = gate.take(last.div_ceil(CHUNK)) {
+        if tx.send(tracer.trace_chunk(seed, c, last)).is_err() {
+            return;
+        }
+    }
+}
+
+/// Lock `m`; a thread that panicked holding it has already failed the run.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}

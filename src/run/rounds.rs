@@ -22,10 +22,10 @@ use super::{ConvergenceRow, RunOptions, StoppedBy, relative_error};
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Tally};
 use crate::tracer::{CHUNK, Tracer};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::sync::{Condvar, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Photons per round unit: one chunk for every group.
 const ROUND_UNIT: u64 = CHUNK * GROUPS as u64;
@@ -54,6 +54,9 @@ struct Gate {
     stop: AtomicBool,
     wait: Mutex<()>,
     moved: Condvar,
+    /// Workers waiting for the limit to move or done with their work: when all are, no
+    /// chunk is on its way.
+    idle: AtomicUsize,
 }
 
 impl Gate {
@@ -68,9 +71,11 @@ impl Gate {
             return Some(c);
         }
         let mut guard = lock(&self.wait);
+        self.idle.fetch_add(1, Ordering::SeqCst);
         while c >= self.limit.load(Ordering::Acquire) && !self.stopped() {
             guard = self.moved.wait(guard).unwrap_or_else(|e| e.into_inner());
         }
+        self.idle.fetch_sub(1, Ordering::SeqCst);
         (!self.stopped()).then_some(c)
     }
 
@@ -146,6 +151,7 @@ impl Rounds {
             stop: AtomicBool::new(false),
             wait: Mutex::new(()),
             moved: Condvar::new(),
+            idle: AtomicUsize::new(0),
         };
         let (last, seed) = (self.last, o.seed);
         let (tx, rx) = channel();
@@ -203,9 +209,7 @@ impl Rounds {
                     missing -= 1;
                 }
             }
-            // Every worker gone with chunks missing: one panicked, and the scope
-            // re-raises its panic once this one unwinds.
-            let chunk = rx.recv().expect("a worker ended without its chunk");
+            let chunk = receive(rx, gate, pool.current_num_threads());
             if chunk.index < end.div_ceil(CHUNK) {
                 self.absorb(&chunk, progress);
                 missing -= 1;
@@ -274,7 +278,31 @@ fn work(gate: &Gate, tracer: &Tracer, seed: u64, last: u64, tx: Sender<ChunkTall
     let _halt = HaltOnPanic(gate);
     while let Some(c) = gate.take(last.div_ceil(CHUNK)) {
         if tx.send(tracer.trace_chunk(seed, c, last)).is_err() {
-            return;
+            break;
+        }
+    }
+    gate.idle.fetch_add(1, Ordering::SeqCst);
+}
+
+/// The next chunk from the `workers` behind `gate`, for a round still missing chunks.
+/// Panics, rather than waiting for ever, when none can come: every worker gone (one
+/// panicked, and the scope re-raises its panic once this one unwinds), or every worker
+/// idle with nothing sent (a chunk lost in the rounds' bookkeeping: a bug).
+fn receive(rx: &Receiver<ChunkTally>, gate: &Gate, workers: usize) -> ChunkTally {
+    loop {
+        match rx.recv_timeout(Duration::from_millis(100)) {
+            Ok(chunk) => return chunk,
+            Err(RecvTimeoutError::Disconnected) => panic!("a worker ended without its chunk"),
+            Err(RecvTimeoutError::Timeout) => {
+                // A worker sends before it turns idle, so once all are idle, whatever
+                // they sent is in the channel.
+                if gate.idle.load(Ordering::SeqCst) == workers {
+                    match rx.try_recv() {
+                        Ok(chunk) => return chunk,
+                        Err(_) => panic!("every worker is idle and a round misses a chunk"),
+                    }
+                }
+            }
         }
     }
 }
@@ -282,4 +310,66 @@ fn work(gate: &Gate, tracer: &Tracer, seed: u64, last: u64, tx: Sender<ChunkTall
 /// Lock `m`; a thread that panicked holding it has already failed the run.
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gate(limit: u64) -> Gate {
+        Gate {
+            next: AtomicU64::new(0),
+            limit: AtomicU64::new(limit),
+            stop: AtomicBool::new(false),
+            wait: Mutex::new(()),
+            moved: Condvar::new(),
+            idle: AtomicUsize::new(0),
+        }
+    }
+
+    /// Workers wait at the limit, go on when it is raised, and stop when halted.
+    #[test]
+    fn the_gate_hands_out_chunks_in_order_up_to_its_limit() {
+        let g = gate(2);
+        assert_eq!((g.take(10), g.take(10)), (Some(0), Some(1)));
+        std::thread::scope(|s| {
+            let waiting = s.spawn(|| g.take(10));
+            while g.idle.load(Ordering::SeqCst) == 0 {
+                std::thread::yield_now();
+            }
+            g.raise(3);
+            assert_eq!(waiting.join().unwrap(), Some(2));
+            let parked = s.spawn(|| g.take(10));
+            while g.idle.load(Ordering::SeqCst) == 0 {
+                std::thread::yield_now();
+            }
+            g.halt();
+            assert_eq!(parked.join().unwrap(), None);
+        });
+        assert_eq!(g.take(4), None, "past the end");
+    }
+
+    /// A round waiting for a chunk no worker will send fails instead of hanging.
+    #[test]
+    fn a_chunk_that_cannot_come_is_a_panic_not_a_hang() {
+        let g = gate(0);
+        let (tx, rx) = channel::<ChunkTally>();
+        std::thread::scope(|s| {
+            let workers: Vec<_> = (0..2).map(|_| s.spawn(|| g.take(10))).collect();
+            let lost =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| receive(&rx, &g, 2)));
+            let why = lost
+                .err()
+                .and_then(|e| e.downcast_ref::<&str>().map(|s| s.to_string()));
+            assert_eq!(
+                why.as_deref(),
+                Some("every worker is idle and a round misses a chunk")
+            );
+            g.halt();
+            workers
+                .into_iter()
+                .for_each(|w| assert_eq!(w.join().unwrap(), None));
+        });
+        drop(tx);
+    }
 }

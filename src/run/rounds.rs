@@ -9,13 +9,13 @@
 //! the stopping rules are asked. The workers never wait for that: each takes the next
 //! chunk in index order and sends what it traced to the calling thread, which absorbs the
 //! chunks of the current round, holds those of the next, and takes the round's row as
-//! soon as its last chunk arrives, while the workers trace on. Workers may run at most
-//! one round unit past the current round's end (the next round is at least that long),
-//! so when a rule stops the run the chunks traced beyond its last round (a few, at most a
-//! round unit) are dropped, and the tallies hold exactly the rounds' photons. Every chunk
-//! is the same whichever worker traced it and the sums are integers, so results do not
-//! depend on the thread count; without the wait, a round's end no longer leaves all but
-//! one worker idle (with many threads, most of them).
+//! soon as its last chunk arrives, while the workers trace on. Workers may run past the
+//! current round's end as far as they trace in twice the time the last round's metrics
+//! took, at least one round unit; when a rule stops the run, the chunks traced beyond its
+//! last round (about that much work) are dropped, and the tallies hold exactly the
+//! rounds' photons. Every chunk is the same whichever worker traced it and the sums are
+//! integers, so results do not depend on the thread count; without the wait, a round's
+//! end no longer leaves all but one worker idle (with many threads, most of them).
 
 use super::metrics::{self, GROUPS, MetricValues, ScoredBins};
 use super::{ConvergenceRow, RunOptions, StoppedBy, relative_error};
@@ -188,6 +188,7 @@ impl Rounds {
             while missing == 0 {
                 self.traced = end;
                 let seconds = start.elapsed().as_secs_f64();
+                let recording = Instant::now();
                 if end == self.last {
                     // No chunk is left to trace: the workers are free to share the
                     // jackknife (asking them earlier would wait for their chunks).
@@ -200,7 +201,7 @@ impl Rounds {
                 }
                 end = self.next_round_end(o, seconds);
                 let end_chunk = end.div_ceil(CHUNK);
-                gate.raise(end_chunk + GROUPS as u64);
+                gate.raise(end_chunk + self.lead(seconds, recording.elapsed().as_secs_f64()));
                 missing = end_chunk - self.traced / CHUNK;
                 let (now, later) = ahead.drain(..).partition(|c| c.index < end_chunk);
                 ahead = later;
@@ -217,6 +218,18 @@ impl Rounds {
                 ahead.push(chunk);
             }
         }
+    }
+
+    /// How many chunks past a round's end the workers may go: as many as they trace in
+    /// twice the time the last round's metrics took (`recorded` s, after `seconds` s of
+    /// tracing), at least one round unit. So they do not wait for the metrics of a fine
+    /// detector (a million bins take about a second), and a stopping rule drops at most
+    /// about that much work.
+    fn lead(&self, seconds: f64, recorded: f64) -> u64 {
+        let chunks_per_s = (self.traced - self.first) as f64 / CHUNK as f64 / seconds;
+        let cover = (2.0 * recorded * chunks_per_s).ceil();
+        // (NaN, from a zero time, falls to the floor.)
+        (cover.min(1e9) as u64).max(GROUPS as u64)
     }
 
     /// Score a traced chunk into its group and the total.

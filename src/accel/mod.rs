@@ -53,8 +53,8 @@ pub enum BackendChoice {
     Brute,
 }
 
-/// Build the backend `choice` over `mesh`. Call it inside the rayon pool that will trace:
-/// Embree sizes its thread pool from it. Every backend comes behind its mesh's box ([`culled::Culled`]).
+/// Build the backend `choice` over `mesh`, behind the mesh's box ([`culled::Culled`]).
+/// Call it inside the rayon pool that will trace: Embree sizes its thread pool from it.
 pub fn build(choice: BackendChoice, mesh: Arc<Mesh>) -> anyhow::Result<Box<dyn Accel>> {
     let inner: Box<dyn Accel> = match choice {
         // Only a library that cannot be loaded (or has the wrong version) means "no

@@ -133,6 +133,11 @@ impl Aabb {
         }
     }
 
+    /// True when the two boxes share a point (faces included).
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && self.max.cmpge(other.min).all()
+    }
+
     /// True when nothing was added.
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x

@@ -450,3 +450,35 @@ fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Dete
         weight,
     }
 }
+
+/// For the tracer's tests: chunks 0 and 7 (seed 5) of the bundled scene `name`, traced
+/// by a tracer as built (BVH backend, convex path on) and by one changed by `alter`, are
+/// the same bits (ledgers and detections); returns the first tracer's chunks.
+#[cfg(test)]
+fn assert_same_chunks(
+    name: &str,
+    estimator: Estimator,
+    alter: impl FnOnce(&mut Tracer),
+) -> Vec<ChunkTally> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
+    let accel = crate::accel::build(crate::accel::BackendChoice::Bvh, scene.mesh.clone()).unwrap();
+    let facets = scene.mesh.facets();
+    let built = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    let mut altered = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    alter(&mut altered);
+    [0, 7]
+        .map(|chunk| {
+            let (a, b) = (
+                built.trace_chunk(5, chunk, u64::MAX),
+                altered.trace_chunk(5, chunk, u64::MAX),
+            );
+            assert_eq!(a.ledger, b.ledger, "{name} {estimator:?} chunk {chunk}");
+            assert_eq!(
+                a.detections, b.detections,
+                "{name} {estimator:?} chunk {chunk}"
+            );
+            a
+        })
+        .into()
+}

@@ -13,7 +13,7 @@
 //! rays beside it, to tell what the packets gain from what the order alone gains (cache),
 //! and obvhs on the sorted rays too: sorting helps both backends.
 
-use super::{median, rate};
+use super::{median, rate, timed_rate};
 use crate::accel::Accel;
 use crate::accel::bvh::ObvhsBvh;
 use crate::accel::embree::{self, EmbreeAccel, packet::NativePackets};
@@ -23,7 +23,6 @@ use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use anyhow::Result;
 use std::path::Path;
-use std::time::Instant;
 
 /// One row of the lamp-cavity table.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -261,15 +260,12 @@ fn spread_bits(v: u32) -> u32 {
 /// (packing the rays into the packet's layout included).
 fn packet_rate(e: &EmbreeAccel, rays: &[Ray]) -> f64 {
     let queries: Vec<(Ray, f64)> = rays.iter().map(|&r| (r, f64::INFINITY)).collect();
-    let start = Instant::now();
-    let mut checksum = 0u64;
-    for chunk in queries.chunks(8) {
-        for h in e.intersect_packet::<8>(chunk).into_iter().flatten() {
-            checksum += u64::from(h.prim);
-        }
-    }
-    std::hint::black_box(checksum);
-    rays.len() as f64 / start.elapsed().as_secs_f64()
+    timed_rate(rays.len(), || {
+        let packets = queries
+            .chunks(8)
+            .map(|chunk| e.intersect_packet::<8>(chunk));
+        packets.flatten().flatten().map(|h| u64::from(h.prim)).sum()
+    })
 }
 
 #[cfg(test)]

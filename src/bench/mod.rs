@@ -315,10 +315,14 @@ pub fn error_table(
 
 /// Queries per second of `f` over `rays`, single-threaded.
 fn rate(rays: &[Ray], f: impl Fn(&Ray) -> u32) -> f64 {
+    timed_rate(rays.len(), || rays.iter().map(|r| u64::from(f(r))).sum())
+}
+
+/// `queries` over the seconds `run` takes; its checksum is kept from the optimizer.
+fn timed_rate(queries: usize, run: impl FnOnce() -> u64) -> f64 {
     let start = Instant::now();
-    let checksum: u64 = rays.iter().map(|r| u64::from(f(r))).sum();
-    std::hint::black_box(checksum);
-    rays.len() as f64 / start.elapsed().as_secs_f64()
+    std::hint::black_box(run());
+    queries as f64 / start.elapsed().as_secs_f64()
 }
 
 #[cfg(test)]

@@ -183,7 +183,8 @@ impl Rounds {
         progress: &(dyn Fn(u64) + Sync),
     ) -> StoppedBy {
         let mut ahead: Vec<ChunkTally> = Vec::new();
-        let mut missing = end.div_ceil(CHUNK) - self.traced / CHUNK;
+        let mut end_chunk = end.div_ceil(CHUNK);
+        let mut missing = end_chunk - self.traced / CHUNK;
         loop {
             while missing == 0 {
                 self.traced = end;
@@ -200,7 +201,7 @@ impl Rounds {
                     return why;
                 }
                 end = self.next_round_end(o, seconds);
-                let end_chunk = end.div_ceil(CHUNK);
+                end_chunk = end.div_ceil(CHUNK);
                 gate.raise(end_chunk + self.lead(seconds, recording.elapsed().as_secs_f64()));
                 missing = end_chunk - self.traced / CHUNK;
                 let (now, later) = ahead.drain(..).partition(|c| c.index < end_chunk);
@@ -211,7 +212,7 @@ impl Rounds {
                 }
             }
             let chunk = receive(rx, gate, pool.current_num_threads());
-            if chunk.index < end.div_ceil(CHUNK) {
+            if chunk.index < end_chunk {
                 self.absorb(&chunk, progress);
                 missing -= 1;
             } else {

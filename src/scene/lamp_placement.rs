@@ -95,12 +95,11 @@ pub(super) fn contact_warnings(
     let mut out = Vec::new();
     for s in sources {
         let grid = s.emitter.surface_grid(2 * GRID);
-        let (lo, hi) = bounds(grid.iter().map(|g| g.0), reach);
+        let span = Aabb::of(grid.iter().map(|g| g.0)).grown(reach);
         let mut near: BTreeMap<u32, DVec3> = BTreeMap::new();
         for (p, &tag) in mesh.tri_tag.iter().enumerate() {
             let c = mesh.corners(p as u32);
-            let (tlo, thi) = bounds(c.into_iter(), 0.0);
-            if near.contains_key(&tag) || (tlo.cmpgt(hi).any() || thi.cmplt(lo).any()) {
+            if near.contains_key(&tag) || !Aabb::of(c).overlaps(&span) {
                 continue;
             }
             if let Some(at) = touches(mesh, p as u32, c, s, &grid, reach) {
@@ -177,13 +176,11 @@ pub(super) fn source_cuts(
         // the tube, or a point of the triangle between grid points on either side of it);
         // the pad covers the grid's shortfall from the true surface between its points.
         let reach = Aabb::of(grid.iter().map(|g| g.0));
-        let pad = 0.1 * (reach.max - reach.min).max_element() + eps;
-        let (lo, hi) = (reach.min - pad, reach.max + pad);
+        let span = reach.grown(0.1 * (reach.max - reach.min).max_element() + eps);
         let mut hit: BTreeMap<u32, DVec3> = BTreeMap::new();
         for (p, &tag) in mesh.tri_tag.iter().enumerate() {
             let c = mesh.corners(p as u32);
-            let (tlo, thi) = bounds(c.into_iter(), 0.0);
-            if hit.contains_key(&tag) || tlo.cmpgt(hi).any() || thi.cmplt(lo).any() {
+            if hit.contains_key(&tag) || !Aabb::of(c).overlaps(&span) {
                 continue;
             }
             if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {
@@ -238,11 +235,6 @@ fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
             plane.cut_meets(c, half.map(|h| -h), half, eps)
         }
     }
-}
-
-fn bounds(points: impl Iterator<Item = DVec3>, pad: f64) -> (DVec3, DVec3) {
-    let b = Aabb::of(points);
-    (b.min - pad, b.max + pad)
 }
 
 fn mm(p: DVec3) -> String {

@@ -50,61 +50,38 @@ impl BodyBoxes {
             .then(|| Aabb::of([ray.origin, ray.at(reach)]));
         self.per_medium[medium as usize]
             .iter()
-            .filter(move |(_, b)| seg.is_none_or(|s| overlap(&s, b)))
+            .filter(move |(_, b)| seg.is_none_or(|s| s.overlaps(b)))
             .map(|&(i, _)| i)
     }
-}
-
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    a.min.cmple(b.max).all() && a.max.cmpge(b.min).all()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::{self, BackendChoice};
     use crate::optics::surface::Estimator;
-    use crate::tally::ChunkTally;
-    use crate::tracer::Tracer;
+    use crate::tracer::assert_same_chunks;
     use glam::DVec3;
 
     /// Chunks traced with the boxes and with every box the whole space (no body skipped)
     /// are the same bits: the boxes only skip bodies a segment cannot meet.
     #[test]
     fn boxes_skip_only_bodies_out_of_reach() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let everywhere = Aabb {
+            min: DVec3::NEG_INFINITY,
+            max: DVec3::INFINITY,
+        };
         for name in ["notebook14", "phone-led", "direct-lit"] {
-            let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
-            let accel = accel::build(BackendChoice::Bvh, scene.mesh.clone()).unwrap();
-            let facets = scene.mesh.facets();
-            let boxed = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &facets);
-            let all = BodyBoxes::new(&scene).per_medium.iter().flatten().count();
-            assert!(all > 0, "{name}: no lamp bodies");
-            let mut open = Tracer::new(&scene, accel.as_ref(), Estimator::Analog, true, &facets);
-            let everywhere = Aabb {
-                min: DVec3::NEG_INFINITY,
-                max: DVec3::INFINITY,
-            };
-            open.bodies
-                .per_medium
-                .iter_mut()
-                .flatten()
-                .for_each(|b| b.1 = everywhere);
-            for chunk in [0, 3] {
-                let (a, b) = (
-                    boxed.trace_chunk(9, chunk, u64::MAX),
-                    open.trace_chunk(9, chunk, u64::MAX),
+            let chunks = assert_same_chunks(name, Estimator::Analog, |open| {
+                let boxes = &mut open.bodies.per_medium;
+                assert!(
+                    boxes.iter().any(|m| !m.is_empty()),
+                    "{name}: no lamp bodies"
                 );
-                let hits = |c: &ChunkTally| {
-                    c.ledger
-                        .absorbed_by_source
-                        .iter()
-                        .map(|s| s.0)
-                        .sum::<i128>()
-                };
-                assert!(hits(&a) > 0, "{name}: no photon met a lamp body");
-                assert_eq!(a.ledger, b.ledger, "{name} chunk {chunk}");
-                assert_eq!(a.detections, b.detections, "{name} chunk {chunk}");
+                boxes.iter_mut().flatten().for_each(|b| b.1 = everywhere);
+            });
+            for c in &chunks {
+                let lamps: i128 = c.ledger.absorbed_by_source.iter().map(|s| s.0).sum();
+                assert!(lamps > 0, "{name}: no photon met a lamp body");
             }
         }
     }

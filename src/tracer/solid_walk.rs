@@ -255,32 +255,21 @@ fn ink(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::{self, BackendChoice};
-    use crate::tally::ChunkTally;
+    use crate::tracer::assert_same_chunks;
 
     /// Chunks traced with the walk and without it (the general loop all the way, on the
     /// same convex path) are the same bits: ledgers and detections.
     #[test]
     fn the_walk_is_the_general_loop_bit_for_bit() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
         for name in ["bench-box", "notebook14", "wedge-ccfl"] {
-            let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
-            let accel = accel::build(BackendChoice::Bvh, scene.mesh.clone()).unwrap();
-            let facets = scene.mesh.facets();
             for estimator in [Estimator::Analog, Estimator::Weighted] {
-                let walking = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
-                assert!(
-                    walking.walks.solids.iter().any(Option::is_some),
-                    "{name}: nothing to walk"
-                );
-                let mut general = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
-                general.walks.solids.iter_mut().for_each(|s| *s = None);
-                let trace = |t: &Tracer, chunk| -> ChunkTally { t.trace_chunk(5, chunk, u64::MAX) };
-                for chunk in [0, 7] {
-                    let (a, b) = (trace(&walking, chunk), trace(&general, chunk));
-                    assert_eq!(a.ledger, b.ledger, "{name} {estimator:?} chunk {chunk}");
-                    assert_eq!(a.detections, b.detections, "{name} {estimator:?}");
-                    assert!(a.ledger.interactions > 3 * a.ledger.photons, "{name}");
+                let chunks = assert_same_chunks(name, estimator, |general| {
+                    let walks = &mut general.walks.solids;
+                    assert!(walks.iter().any(Option::is_some), "{name}: nothing to walk");
+                    walks.iter_mut().for_each(|s| *s = None);
+                });
+                for c in &chunks {
+                    assert!(c.ledger.interactions > 3 * c.ledger.photons, "{name}");
                 }
             }
         }

@@ -5,7 +5,8 @@
 //! Every case is a function returning one row of `docs/stability.md`: what could go wrong,
 //! what blutrace does, the expected answer and the measured one. Each case is also a test
 //! (the slow ones `#[ignore]`d), and each test checks that the doc's row for it carries the
-//! verdict the case gets now, so the doc cannot silently go stale.
+//! verdict and the measured numbers the case gets now (the numbers where Embree is
+//! available, as it was for the doc's run), so the doc cannot silently go stale.
 //!
 //! ```text
 //! cargo test --release --test stability                      # the fast cases + doc check
@@ -159,7 +160,8 @@ fn render(rows: &[(Row, bool, f64)]) -> String {
          ```text\n{REGENERATE}\n```\n\n\
          (all cases, including the slow ones; about a minute in release on 2 cores). `cargo test --release \
          --test stability` runs the fast cases and checks that each has a row here with the \
-         verdict it gets now; `-- --ignored` runs the slow ones. Every run is seeded, so the \
+         verdict and the measured numbers it gets now (the numbers on a machine with Embree, \
+         as this run had; the run times vary); `-- --ignored` runs the slow ones. Every run is seeded, so the \
          measured numbers are reproducible; Monte Carlo tolerances are in standard errors \
          (SE), floating-point ones in units of the rounding error (eps = 2^-52).\n\n\
          Verdicts: **pass** (measured agrees with expected), **open** (a known deviation, \
@@ -201,16 +203,23 @@ fn render(rows: &[(Row, bool, f64)]) -> String {
     s
 }
 
-/// The verdict word the committed doc gives case `id`, if it has a row for it.
-fn doc_verdict(id: &str) -> Option<String> {
+/// The committed doc's row for case `id`: its measured cell without the run time that
+/// `render` appends, and its verdict word.
+fn doc_row(id: &str) -> Option<(String, String)> {
     let text = std::fs::read_to_string(doc_path()).ok()?;
     let key = format!("| `{id}`");
     let line = text.lines().find(|l| l.starts_with(&key))?;
-    let last = line.trim_end_matches('|').rsplit('|').next()?;
-    Some(last.trim().trim_matches('*').to_string())
+    let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+    let [_, _, _, _, _, measured, verdict, _] = cells[..] else {
+        return None;
+    };
+    let measured = measured.rsplit_once(" (").map_or(measured, |(m, _)| m);
+    Some((measured.to_string(), verdict.trim_matches('*').to_string()))
 }
 
-/// Run case `id` as a test: it must not fail, and the doc's row must carry its verdict.
+/// Run case `id` as a test: it must not fail, and the doc's row must carry its verdict
+/// and, where this machine has Embree (as the doc's run had), its measured numbers: every
+/// case is seeded, so a row that differs is a stale row.
 fn run_case(id: &str) {
     let (_, _, f) = CASES
         .iter()
@@ -229,13 +238,20 @@ fn run_case(id: &str) {
             r.expected, r.measured
         );
     }
-    let documented = doc_verdict(id);
+    let documented = doc_row(id);
     assert_eq!(
-        documented.as_deref(),
+        documented.as_ref().map(|d| d.1.as_str()),
         Some(r.verdict.word()),
         "{DOC} is stale for `{id}` (it says {documented:?}, the case gives '{}'): run `{REGENERATE}`",
         r.verdict.word()
     );
+    if accel::embree::info().is_ok() {
+        assert_eq!(
+            documented.map(|d| d.0),
+            Some(cell(&r.measured)),
+            "{DOC}'s measured numbers for `{id}` are stale: run `{REGENERATE}`"
+        );
+    }
 }
 
 macro_rules! case_tests {

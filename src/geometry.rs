@@ -138,6 +138,11 @@ impl Aabb {
         self.min.cmple(other.max).all() && self.max.cmpge(other.min).all()
     }
 
+    /// True when `p` lies in the box (faces included).
+    pub fn contains_point(&self, p: DVec3) -> bool {
+        self.min.cmple(p).all() && p.cmple(self.max).all()
+    }
+
     /// True when nothing was added.
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x

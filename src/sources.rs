@@ -428,6 +428,30 @@ impl Emitter {
         out
     }
 
+    /// The interval of `n . p` over the points `p` of the emitting surface (the tube's
+    /// side, or the rectangle), `n` any vector: its support in both directions.
+    pub fn extent_along(&self, n: DVec3) -> (f64, f64) {
+        let (mid, reach) = match self {
+            Emitter::Ccfl {
+                center,
+                axis,
+                radius,
+                length,
+            } => {
+                let a = axis.dot(n);
+                let across = (n.length_squared() - a * a).max(0.0).sqrt();
+                (center.dot(n), radius * across + 0.5 * length * a.abs())
+            }
+            Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
+                let r = self.rect().expect("an LED has a rectangle");
+                let v = r.normal.cross(r.u);
+                let reach = r.half_width * r.u.dot(n).abs() + r.half_height * v.dot(n).abs();
+                (r.center.dot(n), reach)
+            }
+        };
+        (mid - reach, mid + reach)
+    }
+
     /// The distance (mm) from `p` to the emitting surface (the tube's side, or the
     /// rectangle).
     pub fn surface_distance(&self, p: DVec3) -> f64 {
@@ -647,5 +671,46 @@ mod tests {
         let s = Sources::new(vec![led(1.0), led(3.0)]);
         assert_eq!(s.cdf, vec![0.25, 1.0]);
         assert_eq!(s.total_power(), 4.0);
+    }
+
+    /// The support interval holds every point of a fine grid on the surface, and the
+    /// grid's extremes come within a grid cell of its ends: neither too narrow (the
+    /// placement check would miss a cut) nor loose.
+    #[test]
+    fn extent_along_is_the_surface_support() {
+        let tilted = DVec3::new(0.3, 1.0, -0.2).normalize();
+        let emitters = [
+            Emitter::Ccfl {
+                center: DVec3::new(1.0, 2.0, 3.0),
+                axis: tilted,
+                radius: 1.5,
+                length: 10.0,
+            },
+            Emitter::Led {
+                center: DVec3::new(-4.0, 0.5, 2.0),
+                normal: tilted,
+                u: tilted.any_orthonormal_vector(),
+                width: 3.0,
+                height: 1.0,
+                cos_exponent: 1.0,
+            },
+        ];
+        let dirs = [DVec3::X, DVec3::new(0.2, -3.0, 0.7), tilted, -tilted * 2.0];
+        for e in &emitters {
+            let grid = e.surface_grid(200);
+            for n in dirs {
+                let (lo, hi) = e.extent_along(n);
+                let (glo, ghi) = grid.iter().fold((f64::MAX, f64::MIN), |(a, b), (p, _)| {
+                    (a.min(n.dot(*p)), b.max(n.dot(*p)))
+                });
+                let tol = 1e-12 * (lo.abs() + hi.abs());
+                let cell = 0.01 * (hi - lo) + 1e-9;
+                assert!(
+                    lo - tol <= glo && ghi <= hi + tol,
+                    "{e:?} {n}: grid outside"
+                );
+                assert!(glo - lo < cell && hi - ghi < cell, "{e:?} {n}: loose");
+            }
+        }
     }
 }

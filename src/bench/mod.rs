@@ -25,9 +25,11 @@
 
 pub mod box_scene;
 pub mod cavity;
+pub mod load;
 pub mod reference;
 
 pub use cavity::large_mesh_table;
+pub use load::large_load_row;
 
 use crate::accel::{self, Accel, BackendChoice};
 use crate::geometry::Ray;

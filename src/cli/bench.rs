@@ -27,7 +27,8 @@ pub(super) fn bench(
         "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
     );
     println!("|---|---:|---|---|---:|---:|---:|");
-    for r in crate::bench::trace_table(scene, photons, threads, repeat)? {
+    let traced = crate::bench::trace_table(scene, photons, threads, repeat)?;
+    for r in &traced {
         println!(
             "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
             r.scene,
@@ -40,6 +41,7 @@ pub(super) fn bench(
         );
     }
     println!();
+    print_load(scene, &traced, repeat)?;
     let table = crate::bench::in_guide_table(scene, 1_000_000, repeat)?;
     let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
     println!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
@@ -84,5 +86,37 @@ pub(super) fn bench(
             r.fom_bins
         );
     }
+    Ok(())
+}
+
+/// The large mesh's load time, and the photons the fastest configuration of the trace
+/// table traces on that mesh in the same time.
+fn print_load(scene: &Path, traced: &[crate::bench::BenchRow], repeat: usize) -> Result<()> {
+    let load = crate::bench::large_load_row(scene, repeat)?;
+    let Some(fastest) = traced
+        .iter()
+        .filter(|r| r.triangles == load.triangles)
+        .max_by(|a, b| a.photons_per_s.total_cmp(&b.photons_per_s))
+    else {
+        anyhow::bail!(
+            "the trace table has no row for the {}-triangle mesh",
+            load.triangles
+        );
+    };
+    let path = if fastest.convex { "on" } else { "off" };
+    println!(
+        "| loading with every check | triangles | OBJ (MB) | seconds | photons traced in that time ({}, convex path {path}) |",
+        fastest.backend
+    );
+    println!("|---|---:|---:|---:|---:|");
+    println!(
+        "| {} | {} | {:.0} | {:.2} | {:.0} |",
+        fastest.scene,
+        load.triangles,
+        load.obj_bytes as f64 / 1e6,
+        load.seconds,
+        load.seconds * fastest.photons_per_s
+    );
+    println!();
     Ok(())
 }

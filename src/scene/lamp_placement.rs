@@ -183,7 +183,7 @@ pub(super) fn source_cuts(
             if hit.contains_key(&tag) || !Aabb::of(c).overlaps(&span) {
                 continue;
             }
-            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &grid, eps) {
+            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, s, &grid, eps) {
                 hit.insert(tag, c[0] + offset);
             }
         }
@@ -199,8 +199,19 @@ pub(super) fn source_cuts(
 
 /// True when points of the emitting surface's `grid` lie more than `eps` on both sides of
 /// triangle `prim`, with their feet inside it: the triangle passes through the surface
-/// (a sheet through a tube, whose vertices all lie outside it).
-fn crosses_grid(mesh: &Mesh, prim: u32, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
+/// (a sheet through a tube, whose vertices all lie outside it). Unless the whole emitting
+/// surface reaches more than `eps` to both sides of the plane, no grid point can: the
+/// common case (a reflector facet beside the lamp) is settled without the grid, which
+/// on a finely meshed reflector would cost a point-in-triangle test per facet and point.
+fn crosses_grid(mesh: &Mesh, prim: u32, s: &Source, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
+    let n = mesh.area_normal(prim).normalize_or_zero();
+    let (lo, hi) = s.emitter.extent_along(n);
+    let base = n.dot(mesh.corners(prim)[0]);
+    // Rounding slack: the grid's heights are computed another way, n . (g - corner).
+    let slack = 1e-9 * (lo.abs() + hi.abs() + base.abs());
+    if !(lo - base - slack < -eps && hi - base + slack > eps) {
+        return false;
+    }
     let (mut above, mut below) = (false, false);
     over_triangle(mesh, prim, grid)
         .filter(|&(_, h)| h.abs() > eps)

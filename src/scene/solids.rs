@@ -2,7 +2,7 @@
 //! consistently wound surface, or photons would leak through the gaps. Faces are
 //! re-wound so normals point out of the medium they enclose.
 
-use crate::geometry::Mesh;
+use crate::geometry::{Aabb, Mesh};
 use crate::optics::medium::Medium;
 use crate::optics::surface::SurfaceModel;
 use crate::spec_check::Ctx;
@@ -207,14 +207,15 @@ pub(super) fn overlap_warnings(
     surfaces_by_tri: impl Fn(usize) -> Option<crate::optics::medium::Interface>,
     media: &[Medium],
 ) -> Vec<String> {
-    let solids: Vec<(usize, Vec<usize>)> = closed_solids(mesh, &surfaces_by_tri, media.len())
-        .into_iter()
-        .map(|s| (s.medium, s.tris))
-        .collect();
+    let solids = closed_solids(mesh, &surfaces_by_tri, media.len());
     let mut out = Vec::new();
-    for (m, tris) in &solids {
+    for Solid {
+        medium: m, tris, ..
+    } in &solids
+    {
         let verts = sample_vertices(mesh, tris);
-        for (k, other) in solids.iter().filter(|(k, _)| k != m) {
+        for other in solids.iter().filter(|o| o.medium != *m) {
+            let k = &other.medium;
             let w: Vec<f64> = verts.iter().map(|&p| winding(mesh, other, p)).collect();
             let inside = w.iter().any(|&w| w > 0.75);
             let outside = w.iter().any(|&w| w < 0.25);
@@ -248,6 +249,8 @@ pub(super) struct Solid {
     pub tris: Vec<usize>,
     /// Its enclosed volume (mm^3).
     pub volume: f64,
+    /// The box of its triangles: outside it the winding number is 0.
+    pub bounds: Aabb,
 }
 
 /// The closed solid of every medium but air that some face names inside.
@@ -268,6 +271,7 @@ pub(super) fn closed_solids(
         .filter(|(_, t)| !t.is_empty())
         .map(|(medium, tris)| Solid {
             medium,
+            bounds: Aabb::of(tris.iter().flat_map(|&p| mesh.corners(p as u32))),
             volume: tris
                 .iter()
                 .map(|&p| signed_volume(mesh, p))
@@ -283,7 +287,7 @@ pub(super) fn closed_solids(
 pub(super) fn medium_at(mesh: &Mesh, solids: &[Solid], p: glam::DVec3) -> usize {
     solids
         .iter()
-        .filter(|s| winding(mesh, &s.tris, p) > 0.5)
+        .filter(|s| winding(mesh, s, p) > 0.5)
         .min_by(|a, b| a.volume.total_cmp(&b.volume))
         .map_or(0, |s| s.medium)
 }
@@ -312,10 +316,16 @@ fn sample_vertices(mesh: &Mesh, tris: &[usize]) -> Vec<glam::DVec3> {
         .collect()
 }
 
-/// Generalized winding number of the closed, outward-wound surface `tris` about `p`:
+/// Generalized winding number of the closed, outward-wound surface of `solid` about `p`:
 /// 1 inside, 0 outside, 1/2 on the surface (van Oosterom and Strackee's solid angle).
-fn winding(mesh: &Mesh, tris: &[usize], p: glam::DVec3) -> f64 {
-    let total: f64 = tris
+/// A point beyond the solid's box is outside without a sum over its triangles (a lamp
+/// beside a finely meshed guide would cost an `atan2` per triangle and grid point).
+fn winding(mesh: &Mesh, solid: &Solid, p: glam::DVec3) -> f64 {
+    if !solid.bounds.contains_point(p) {
+        return 0.0;
+    }
+    let total: f64 = solid
+        .tris
         .iter()
         .map(|&t| {
             let [a, b, c] = mesh.corners(t as u32).map(|x| x - p);

@@ -178,7 +178,7 @@ impl Aabb {
 }
 
 /// A triangle soup with one material tag index per triangle.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Vertex positions (mm).
     pub positions: Vec<DVec3>,

@@ -16,7 +16,8 @@
 //! the median of `R` (default 3) rounds, each round measuring every configuration once in
 //! turn, so a passing load on the machine does not favour one of them. For each backend
 //! (with and without the convex-solid fast path) it traces the same photons and reports
-//! rates and the ratio to obvhs. A second table times nearest-hit queries of rays inside
+//! rates and the ratio to obvhs, then the time to load the 540k-triangle scene from an OBJ
+//! with every load check ([`load`]). A next table times nearest-hit queries of rays inside
 //! the light guide alone: the convex path against each backend; a third, queries in the
 //! lamp cavities against the 540k-triangle mesh alone ([`cavity`], at most 3 rounds): the
 //! backends without the shared per-hit code, and Embree's ray packets on emission and

@@ -6,10 +6,11 @@ use super::report::IterationReport;
 use super::traced::TracedRun;
 use crate::optics::dots::{Density, DotPattern};
 use crate::optics::surface::SurfaceModel;
-use crate::run::RunOptions;
+use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -148,6 +149,9 @@ pub(super) struct Search<'a> {
     /// Objective facts per evaluated parameter vector (for progress reports).
     pub(super) seen: HashMap<Vec<u64>, Evaluation>,
     pub(super) history: Vec<IterationReport>,
+    /// The backend and triangle records of the scene's mesh, built by the first trace and
+    /// reused by every design after it (only the dots change).
+    pub(super) builds: RefCell<MeshBuildCache>,
 }
 
 impl<'a> Search<'a> {
@@ -180,6 +184,7 @@ impl<'a> Search<'a> {
             best: None,
             seen: HashMap::new(),
             history: Vec::new(),
+            builds: RefCell::default(),
         })
     }
 
@@ -217,6 +222,7 @@ impl<'a> Search<'a> {
             self.strips,
             self.options.edge_margin_mm,
             self.tag_id,
+            &mut self.builds.borrow_mut(),
         )?;
         self.photons += ev.photons;
         if self.first.is_none() {
@@ -267,5 +273,29 @@ impl<'a> Search<'a> {
         };
         progress(&r);
         self.history.push(r);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// Designs that differ only in their dots share one backend build; the first builds it.
+    #[test]
+    fn designs_reuse_the_first_designs_backend() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bench-box");
+        let scene = Scene::load(&dir.join("scene.toml")).unwrap();
+        let options = OptimizeOptions {
+            photons: 4096,
+            threads: Some(1),
+            ..OptimizeOptions::default()
+        };
+        let mut search = Search::new(&scene, &options).unwrap();
+        for d in [0.1, 0.2, 0.3] {
+            search.evaluate(&Density::Polynomial(vec![d])).unwrap();
+        }
+        assert_eq!(search.evaluations, 3);
+        assert_eq!(search.builds.borrow().builds(), 1);
     }
 }

@@ -3,7 +3,7 @@
 use super::objective::Evaluation;
 use super::search::dots_pattern;
 use crate::run::metrics::MetricValues;
-use crate::run::{self, ConvergenceRow, RunOptions, RunResult, StoppedBy};
+use crate::run::{self, ConvergenceRow, MeshBuildCache, RunOptions, RunResult, StoppedBy};
 use crate::scene::Scene;
 use crate::tally::Tally;
 use anyhow::Result;
@@ -32,29 +32,33 @@ impl TracedRun {
         strips: usize,
         margin: f64,
         tag_id: usize,
+        builds: &mut MeshBuildCache,
     ) -> Result<(TracedRun, Evaluation)> {
-        let (run, evaluation) = Self::trace_judged(scene, options, |r| -> Result<Evaluation> {
-            let pattern = dots_pattern(r.scene, tag_id)?;
-            Ok(Evaluation::of(
-                r.scene,
-                pattern,
-                r.flux_map(),
-                strips,
-                margin,
-                r.tally.ledger.photons,
-                r.runtime_s,
-            ))
-        })?;
+        let (run, evaluation) =
+            Self::trace_judged(scene, options, builds, |r| -> Result<Evaluation> {
+                let pattern = dots_pattern(r.scene, tag_id)?;
+                Ok(Evaluation::of(
+                    r.scene,
+                    pattern,
+                    r.flux_map(),
+                    strips,
+                    margin,
+                    r.tally.ledger.photons,
+                    r.runtime_s,
+                ))
+            })?;
         Ok((run, evaluation?))
     }
 
-    /// Trace `scene` and judge the finished run with `judge`.
+    /// Trace `scene` (reusing `builds` when the mesh is the last run's) and judge the
+    /// finished run with `judge`.
     pub(super) fn trace_judged<T>(
         scene: Scene,
         options: &RunOptions,
+        builds: &mut MeshBuildCache,
         judge: impl FnOnce(&RunResult) -> T,
     ) -> Result<(TracedRun, T)> {
-        let r = run::trace(&scene, options, &|_| {})?;
+        let r = run::trace_reusing(&scene, options, builds, &|_| {})?;
         let judged = judge(&r);
         let RunResult {
             scene: _,

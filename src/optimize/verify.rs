@@ -47,6 +47,7 @@ fn verify_design(
         search.strips,
         search.options.edge_margin_mm,
         search.tag_id,
+        &mut search.builds.borrow_mut(),
     )?;
     let summary = run.result().summary();
     let design = VerifiedDesign {

@@ -20,11 +20,12 @@
 //! - `summary.json`: run facts, energy ledger, uniformity and errors.
 
 mod images;
+pub mod mesh_build;
 pub mod metrics;
 mod rounds;
 pub mod summary;
 
-use crate::accel::{self, Accel, BackendChoice};
+use crate::accel::{self, BackendChoice};
 use crate::optics::surface::Estimator;
 use crate::output::{
     self,
@@ -34,6 +35,7 @@ use crate::scene::Scene;
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
+pub use mesh_build::MeshBuildCache;
 use metrics::{GROUPS, Map, Metric, MetricValues};
 use rounds::Rounds;
 use serde::Serialize;
@@ -248,6 +250,17 @@ pub fn trace<'a>(
     options: &RunOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RunResult<'a>> {
+    trace_reusing(scene, options, &mut MeshBuildCache::default(), progress)
+}
+
+/// [`trace`], reusing `builds`' backend and triangle records when the last run's mesh was
+/// this scene's (and leaving this run's there for the next).
+pub fn trace_reusing<'a>(
+    scene: &'a Scene,
+    options: &RunOptions,
+    builds: &mut MeshBuildCache,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RunResult<'a>> {
     if let Some(e) = options.target_error
         && !(e > 0.0 && e.is_finite())
     {
@@ -271,15 +284,16 @@ pub fn trace<'a>(
         .num_threads(options.threads.unwrap_or(0))
         .build()
         .context("cannot start worker threads")?;
-    let accel: Box<dyn Accel> =
-        pool.install(|| accel::build(options.backend, scene.mesh.clone()))?;
-    let facets = scene.mesh.facets();
+    let built = builds.get(&scene.mesh, options.backend, || {
+        pool.install(|| accel::build(options.backend, scene.mesh.clone()))
+    })?;
+    let accel = built.accel.as_ref();
     let tracer = Tracer::new(
         scene,
-        accel.as_ref(),
+        accel,
         options.estimator,
         options.convex,
-        &facets,
+        &built.facets,
     );
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();

@@ -79,6 +79,7 @@ pub fn optimize_layout(
         history: Vec::new(),
         best: None,
         seen: Default::default(),
+        builds: Default::default(),
     };
     let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
     search.evaluate(&initial_x, progress)?;

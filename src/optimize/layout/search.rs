@@ -5,11 +5,12 @@ use super::objective::{LayoutEvaluation, ObjectiveSpec};
 use super::vary::Variable;
 use crate::optimize::OptimizeOptions;
 use crate::optimize::traced::TracedRun;
-use crate::run::RunOptions;
+use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use crate::scene::config::SceneFile;
 use anyhow::Result;
 use serde::Serialize;
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::time::Instant;
 use toml::Value;
@@ -64,6 +65,9 @@ pub(super) struct LayoutSearch<'a> {
     /// Objective of every design evaluated, by the bits of its variables: a design met
     /// again (the scene's own at the start of each case) is not traced twice.
     pub(super) seen: HashMap<Vec<u64>, (f64, f64)>,
+    /// The last design's backend and triangle records, reused by the next design when
+    /// its mesh is the same (a search that moves only the lamps).
+    pub(super) builds: RefCell<MeshBuildCache>,
 }
 
 impl<'a> LayoutSearch<'a> {
@@ -96,7 +100,8 @@ impl<'a> LayoutSearch<'a> {
         scene: Scene,
         run_options: &RunOptions,
     ) -> Result<(TracedRun, LayoutEvaluation)> {
-        TracedRun::trace_judged(scene, run_options, |r| self.objective.evaluate(r))
+        let builds = &mut self.builds.borrow_mut();
+        TracedRun::trace_judged(scene, run_options, builds, |r| self.objective.evaluate(r))
     }
 
     /// Evaluate the design `x` (inside the bounds): its objective and standard error, or

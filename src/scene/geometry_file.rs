@@ -24,7 +24,7 @@
 //! (negative determinant) keeps faces outward by reversing their winding; a singular one
 //! is refused; one that shears or stretches unevenly is accepted with a warning.
 
-use super::meshio::{self, TaggedTriangles};
+use super::meshio::{ReadCache, TaggedTriangles};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::{DMat3, DMat4, DVec3};
@@ -101,7 +101,7 @@ pub enum UpAxis {
 }
 
 /// Geometry file formats, by file extension.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Format {
     /// Wavefront OBJ (tags: `usemtl`, else `o`/`g` names).
     Obj,
@@ -195,13 +195,14 @@ impl GeometrySpec {
     }
 
     /// Read the file at `path` (this spec's `file`, resolved) into scene millimetres, with
-    /// tags from the file or from `tag`.
+    /// tags from the file or from `tag` (through `reads`: a file read before is copied).
     pub fn load(
         &self,
         ctx: &Ctx,
         i: usize,
         path: &Path,
         warnings: &mut Vec<String>,
+        reads: &ReadCache,
     ) -> Result<TaggedTriangles> {
         let format = Format::of(path).ok_or_else(|| {
             ctx.err(
@@ -227,7 +228,8 @@ impl GeometrySpec {
             return Err(ctx.err(&format!("geometry[{i}].tag"), "must not be empty"));
         }
         let placement = self.placement(ctx, i, format, warnings)?;
-        let mut tris = meshio::load(path, format, placement.transform, self.tag.as_deref())
+        let mut tris = reads
+            .load(path, format, placement.transform, self.tag.as_deref())
             .map_err(|e| ctx.err(&format!("geometry[{i}].file"), format!("{e:#}")))?;
         if placement.mirrors {
             tris.triangles.iter_mut().for_each(|t| t.swap(1, 2));

@@ -8,11 +8,14 @@
 use super::geometry_file::Format;
 use anyhow::{Context, Result, bail};
 use glam::{DMat4, DVec3};
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::io::BufReader;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
 
 /// Triangles read from one file, each with its tag.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TaggedTriangles {
     /// Vertex positions (mm).
     pub positions: Vec<DVec3>,
@@ -53,6 +56,60 @@ impl TaggedTriangles {
             self.tags.push(tag.to_string());
         }
         Ok(())
+    }
+}
+
+/// Files read so far, by everything a read depends on: the file (path, size and
+/// modification time, so an edited file is read again), its format, the transform and the
+/// tag. A layout search loads every design from the same files: each is parsed once (a
+/// third of the load time of a 540k-triangle OBJ).
+#[derive(Default)]
+pub struct ReadCache {
+    files: RefCell<HashMap<ReadKey, TaggedTriangles>>,
+    reads: RefCell<usize>,
+}
+
+#[derive(PartialEq, Eq, Hash)]
+struct ReadKey {
+    path: PathBuf,
+    len: u64,
+    modified: Option<SystemTime>,
+    format: Format,
+    transform: [u64; 16],
+    tag: Option<String>,
+}
+
+impl ReadCache {
+    /// [`load`], or a copy of what it returned for the same file and arguments.
+    pub fn load(
+        &self,
+        path: &Path,
+        format: Format,
+        transform: DMat4,
+        tag: Option<&str>,
+    ) -> Result<TaggedTriangles> {
+        let meta =
+            std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let key = ReadKey {
+            path: path.to_path_buf(),
+            len: meta.len(),
+            modified: meta.modified().ok(),
+            format,
+            transform: transform.to_cols_array().map(f64::to_bits),
+            tag: tag.map(str::to_string),
+        };
+        if let Some(t) = self.files.borrow().get(&key) {
+            return Ok(t.clone());
+        }
+        let tris = load(path, format, transform, tag)?;
+        *self.reads.borrow_mut() += 1;
+        self.files.borrow_mut().insert(key, tris.clone());
+        Ok(tris)
+    }
+
+    /// Files read from disk so far (a copy from the cache is not a read).
+    pub fn reads(&self) -> usize {
+        *self.reads.borrow()
     }
 }
 
@@ -299,5 +356,37 @@ fn ply_indices(p: &ply_rs_bw::ply::Property) -> Option<Vec<u32>> {
         P::ListUShort(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
         P::ListUChar(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ONE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
+    const TWO: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl a\nf 1 2 3\nf 2 4 3\n";
+
+    /// A file is parsed once per placement and tag, and again once it changes on disk.
+    #[test]
+    fn the_read_cache_reads_a_file_once_until_it_changes() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("part.obj");
+        std::fs::write(&path, ONE).unwrap();
+        let cache = ReadCache::default();
+        let read = |m: DMat4, tag: Option<&str>| cache.load(&path, Format::Obj, m, tag).unwrap();
+        let first = read(DMat4::IDENTITY, None);
+        assert_eq!(read(DMat4::IDENTITY, None), first);
+        assert_eq!(cache.reads(), 1);
+        let moved = DMat4::from_translation(DVec3::Z);
+        assert_eq!(read(moved, None).positions[0], DVec3::Z);
+        assert_eq!(read(DMat4::IDENTITY, Some("b")).tags, vec!["b".to_string()]);
+        assert_eq!(cache.reads(), 3);
+        std::fs::write(&path, TWO).unwrap();
+        assert_eq!(read(DMat4::IDENTITY, None).triangles.len(), 2);
+        assert_eq!(cache.reads(), 4);
+        assert_eq!(
+            read(DMat4::IDENTITY, None),
+            load(&path, Format::Obj, DMat4::IDENTITY, None).unwrap()
+        );
     }
 }

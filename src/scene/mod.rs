@@ -29,6 +29,7 @@ use anyhow::{Context, Result};
 use config::{DetectorSpec, SceneFile, SurfaceSpec};
 use geometry_report::GeometryReport;
 use glam::DVec3;
+use meshio::ReadCache;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -84,6 +85,13 @@ impl Scene {
     /// Build a scene from an already parsed scene file; geometry paths are relative to
     /// `path`'s folder.
     pub fn from_file(file: &SceneFile, path: &Path) -> Result<Scene> {
+        Self::from_file_reading(file, path, &ReadCache::default())
+    }
+
+    /// [`Scene::from_file`], reading geometry files through `reads`: a file read for an
+    /// earlier scene with the same placement is copied, not parsed again (the designs of
+    /// a layout search).
+    pub fn from_file_reading(file: &SceneFile, path: &Path, reads: &ReadCache) -> Result<Scene> {
         let ctx = Ctx(path);
         if file.version != config::SCENE_VERSION {
             return Err(ctx.err(
@@ -100,7 +108,7 @@ impl Scene {
         // Sources first: procedural reflectors follow the lamps.
         let sources = Sources::build(&ctx, &file.sources, &media)?;
         let (mut mesh, tags, geometry) =
-            load_geometry(&ctx, file, path, &sources.list, &mut warnings)?;
+            load_geometry(&ctx, file, path, &sources.list, &mut warnings, reads)?;
         let mut surfaces = Vec::with_capacity(tags.len());
         for tag in &tags {
             let spec = file
@@ -325,6 +333,7 @@ fn load_geometry(
     path: &Path,
     lamps: &[crate::sources::Source],
     warnings: &mut Vec<String>,
+    reads: &ReadCache,
 ) -> Result<(Mesh, Vec<String>, Vec<GeometryReport>)> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut tags: Vec<String> = Vec::new();
@@ -338,7 +347,7 @@ fn load_geometry(
                 format!("{} does not exist", gpath.display()),
             ));
         }
-        let tris = g.load(ctx, i, &gpath, warnings)?;
+        let tris = g.load(ctx, i, &gpath, warnings, reads)?;
         // NaN or infinite vertices would poison the bounds, the recentring and the f32
         // backends (a panic in the BVH build); beyond 1e12 mm f64 resolves no better than
         // 0.1 mm: a unit or export error either way.

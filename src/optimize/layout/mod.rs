@@ -80,6 +80,7 @@ pub fn optimize_layout(
         best: None,
         seen: Default::default(),
         builds: Default::default(),
+        reads: Default::default(),
     };
     let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
     search.evaluate(&initial_x, progress)?;

@@ -8,6 +8,7 @@ use crate::optimize::traced::TracedRun;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use crate::scene::config::SceneFile;
+use crate::scene::meshio::ReadCache;
 use anyhow::Result;
 use serde::Serialize;
 use std::cell::RefCell;
@@ -68,6 +69,8 @@ pub(super) struct LayoutSearch<'a> {
     /// The last design's backend and triangle records, reused by the next design when
     /// its mesh is the same (a search that moves only the lamps).
     pub(super) builds: RefCell<MeshBuildCache>,
+    /// The geometry files as read for the first design, copied for the others.
+    pub(super) reads: ReadCache,
 }
 
 impl<'a> LayoutSearch<'a> {
@@ -91,7 +94,7 @@ impl<'a> LayoutSearch<'a> {
             .document(x)
             .try_into()
             .map_err(|e| anyhow::anyhow!("{}: {e}", self.scene.path.display()))?;
-        Scene::from_file(&file, &self.scene.path)
+        Scene::from_file_reading(&file, &self.scene.path, &self.reads)
     }
 
     /// Trace the design `x` with `run_options` and judge it.

@@ -8,7 +8,7 @@
 use super::geometry_file::Format;
 use anyhow::{Context, Result, bail};
 use glam::{DMat4, DVec3};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -66,7 +66,7 @@ impl TaggedTriangles {
 #[derive(Default)]
 pub struct ReadCache {
     files: RefCell<HashMap<ReadKey, TaggedTriangles>>,
-    reads: RefCell<usize>,
+    reads: Cell<usize>,
 }
 
 #[derive(PartialEq, Eq, Hash)]
@@ -102,14 +102,14 @@ impl ReadCache {
             return Ok(t.clone());
         }
         let tris = load(path, format, transform, tag)?;
-        *self.reads.borrow_mut() += 1;
+        self.reads.set(self.reads.get() + 1);
         self.files.borrow_mut().insert(key, tris.clone());
         Ok(tris)
     }
 
     /// Files read from disk so far (a copy from the cache is not a read).
     pub fn reads(&self) -> usize {
-        *self.reads.borrow()
+        self.reads.get()
     }
 }
 

@@ -42,7 +42,7 @@ use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use body::{BodySpec, LampBody};
-use body_shape::Rect;
+use body_shape::{BodyShape, Rect};
 use glam::DVec3;
 use intensity::IntensityProfile;
 use serde::{Deserialize, Serialize};
@@ -428,28 +428,25 @@ impl Emitter {
         out
     }
 
-    /// The interval of `n . p` over the points `p` of the emitting surface (the tube's
-    /// side, or the rectangle), `n` any vector: its support in both directions.
-    pub fn extent_along(&self, n: DVec3) -> (f64, f64) {
-        let (mid, reach) = match self {
+    /// The emitting surface as a body shape: the tube, or the LED's rectangle (a lamp's
+    /// default body, and what placement checks test parts against).
+    pub fn shape(&self) -> BodyShape {
+        match self {
             Emitter::Ccfl {
                 center,
                 axis,
                 radius,
                 length,
-            } => {
-                let a = axis.dot(n);
-                let across = (n.length_squared() - a * a).max(0.0).sqrt();
-                (center.dot(n), radius * across + 0.5 * length * a.abs())
-            }
+            } => BodyShape::Cylinder {
+                center: *center,
+                axis: *axis,
+                radius: *radius,
+                half_length: 0.5 * length,
+            },
             Emitter::Led { .. } | Emitter::MeasuredLed { .. } => {
-                let r = self.rect().expect("an LED has a rectangle");
-                let v = r.normal.cross(r.u);
-                let reach = r.half_width * r.u.dot(n).abs() + r.half_height * v.dot(n).abs();
-                (r.center.dot(n), reach)
+                BodyShape::Rectangle(self.rect().expect("an LED has a rectangle"))
             }
-        };
-        (mid - reach, mid + reach)
+        }
     }
 
     /// The distance (mm) from `p` to the emitting surface (the tube's side, or the
@@ -673,11 +670,11 @@ mod tests {
         assert_eq!(s.total_power(), 4.0);
     }
 
-    /// The support interval holds every point of a fine grid on the surface, and the
-    /// grid's extremes come within a grid cell of its ends: neither too narrow (the
+    /// The emitting shape's support holds every point of a fine grid on the surface, and
+    /// the grid's extremes come within a grid cell of its ends: neither too narrow (the
     /// placement check would miss a cut) nor loose.
     #[test]
-    fn extent_along_is_the_surface_support() {
+    fn the_emitting_shapes_support_bounds_the_surface() {
         let tilted = DVec3::new(0.3, 1.0, -0.2).normalize();
         let emitters = [
             Emitter::Ccfl {
@@ -699,7 +696,7 @@ mod tests {
         for e in &emitters {
             let grid = e.surface_grid(200);
             for n in dirs {
-                let (lo, hi) = e.extent_along(n);
+                let (lo, hi) = e.shape().support(n);
                 let (glo, ghi) = grid.iter().fold((f64::MAX, f64::MIN), |(a, b), (p, _)| {
                     (a.min(n.dot(*p)), b.max(n.dot(*p)))
                 });

@@ -18,6 +18,7 @@ use super::geometry_report::Plane;
 use super::solids;
 use crate::geometry::{Aabb, Mesh};
 use crate::optics::medium::{Interface, Medium};
+use crate::sources::body_shape::BodyShape;
 use crate::sources::{Emitter, Source};
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -172,6 +173,7 @@ pub(super) fn source_cuts(
     let mut out = Vec::new();
     for s in sources {
         let grid = s.emitter.surface_grid(24);
+        let shape = s.emitter.shape();
         // A triangle that cuts the emitter meets the grid's bounding box (a vertex inside
         // the tube, or a point of the triangle between grid points on either side of it);
         // the pad covers the grid's shortfall from the true surface between its points.
@@ -183,7 +185,8 @@ pub(super) fn source_cuts(
             if hit.contains_key(&tag) || !Aabb::of(c).overlaps(&span) {
                 continue;
             }
-            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, s, &grid, eps) {
+            if cuts_emitter(&s.emitter, c, eps) || crosses_grid(mesh, p as u32, &shape, &grid, eps)
+            {
                 hit.insert(tag, c[0] + offset);
             }
         }
@@ -203,9 +206,15 @@ pub(super) fn source_cuts(
 /// surface reaches more than `eps` to both sides of the plane, no grid point can: the
 /// common case (a reflector facet beside the lamp) is settled without the grid, which
 /// on a finely meshed reflector would cost a point-in-triangle test per facet and point.
-fn crosses_grid(mesh: &Mesh, prim: u32, s: &Source, grid: &[(DVec3, DVec3)], eps: f64) -> bool {
+fn crosses_grid(
+    mesh: &Mesh,
+    prim: u32,
+    surface: &BodyShape,
+    grid: &[(DVec3, DVec3)],
+    eps: f64,
+) -> bool {
     let n = mesh.area_normal(prim).normalize_or_zero();
-    let (lo, hi) = s.emitter.extent_along(n);
+    let (lo, hi) = surface.support(n);
     let base = n.dot(mesh.corners(prim)[0]);
     // Rounding slack: the grid's heights are computed another way, n . (g - corner).
     let slack = 1e-9 * (lo.abs() + hi.abs() + base.abs());

@@ -141,26 +141,9 @@ impl LampBody {
     /// The body of `emitter`: its tube, its emitting rectangle, or a box package
     /// `package_depth` deep behind that rectangle.
     pub fn new(emitter: &Emitter, model: SurfaceModel, package_depth: Option<f64>) -> Self {
-        let shape = match (emitter, emitter.rect()) {
-            (
-                Emitter::Ccfl {
-                    center,
-                    axis,
-                    radius,
-                    length,
-                },
-                _,
-            ) => BodyShape::Cylinder {
-                center: *center,
-                axis: *axis,
-                radius: *radius,
-                half_length: 0.5 * length,
-            },
-            (_, Some(front)) => match package_depth {
-                Some(depth) => BodyShape::Package { front, depth },
-                None => BodyShape::Rectangle(front),
-            },
-            (_, None) => unreachable!("only a CCFL has no rectangle"),
+        let shape = match (emitter.rect(), package_depth) {
+            (Some(front), Some(depth)) => BodyShape::Package { front, depth },
+            _ => emitter.shape(),
         };
         Self { shape, model }
     }

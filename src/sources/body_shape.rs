@@ -81,9 +81,9 @@ impl BodyShape {
         (hit.t > 0.0 && hit.t < t_max).then_some(hit)
     }
 
-    /// An axis-aligned box holding the whole body: the tube's end discs swept along its
-    /// axis; the rectangle's corners, and for a package those corners moved `depth` back.
-    pub fn bounds(&self) -> Aabb {
+    /// The interval of `n . p` over the points `p` of the body, `n` any vector: its
+    /// support in both directions (what a plane or a box needs to know of it).
+    pub fn support(&self, n: DVec3) -> (f64, f64) {
         match self {
             BodyShape::Cylinder {
                 center,
@@ -91,13 +91,31 @@ impl BodyShape {
                 radius,
                 half_length,
             } => {
-                // A disc of radius r across unit axis a reaches r sqrt(1 - a_i^2) along
-                // coordinate i.
-                let disc = (DVec3::ONE - *axis * *axis).max(DVec3::ZERO).sqrt() * *radius;
-                let reach = axis.abs() * *half_length + disc;
+                // The end discs, of radius r across unit axis a, reach r |n - (a.n) a|
+                // beyond their centres, which lie half_length |a.n| off the centre.
+                let a = axis.dot(n);
+                let across = (n.length_squared() - a * a).max(0.0).sqrt();
+                let (mid, reach) = (center.dot(n), radius * across + half_length * a.abs());
+                (mid - reach, mid + reach)
+            }
+            BodyShape::Rectangle(r) => r.support(n),
+            BodyShape::Package { front, depth } => {
+                let (lo, hi) = front.support(n);
+                let back = -depth * front.normal.dot(n);
+                (lo + back.min(0.0), hi + back.max(0.0))
+            }
+        }
+    }
+
+    /// An axis-aligned box holding the whole body: the tube's support along the three
+    /// axes; the rectangle's corners, and for a package those corners moved `depth` back.
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            BodyShape::Cylinder { .. } => {
+                let [x, y, z] = [DVec3::X, DVec3::Y, DVec3::Z].map(|n| self.support(n));
                 Aabb {
-                    min: *center - reach,
-                    max: *center + reach,
+                    min: DVec3::new(x.0, y.0, z.0),
+                    max: DVec3::new(x.1, y.1, z.1),
                 }
             }
             BodyShape::Rectangle(r) => Aabb::of(r.corners()),
@@ -120,6 +138,14 @@ impl BodyShape {
 impl Rect {
     fn v(&self) -> DVec3 {
         self.normal.cross(self.u)
+    }
+
+    /// The interval of `n . p` over the rectangle's points.
+    fn support(&self, n: DVec3) -> (f64, f64) {
+        let reach =
+            self.half_width * self.u.dot(n).abs() + self.half_height * self.v().dot(n).abs();
+        let mid = self.center.dot(n);
+        (mid - reach, mid + reach)
     }
 
     fn corners(&self) -> [DVec3; 4] {
@@ -481,5 +507,37 @@ mod tests {
         assert_eq!((rect.min, rect.max), want);
         let pb = p.bounds();
         assert_eq!((pb.min, pb.max), (DVec3::new(-0.6, -1.5, -0.2), want.1));
+    }
+
+    /// A package's support is that of its eight corners, and a tube's box is its support
+    /// along the axes: the support is what the bounds and the placement checks share.
+    #[test]
+    fn support_is_the_extreme_of_the_shape() {
+        let front = Rect {
+            normal: DVec3::new(0.6, 0.0, 0.8),
+            u: DVec3::Y,
+            ..led()
+        };
+        let package = BodyShape::Package { front, depth: 0.7 };
+        let back = front.normal * -0.7;
+        let corners: Vec<DVec3> = front
+            .corners()
+            .into_iter()
+            .flat_map(|c| [c, c + back])
+            .collect();
+        for n in [DVec3::X, DVec3::new(-0.3, 2.0, 0.5), -front.normal] {
+            let (lo, hi) = package.support(n);
+            let dots = corners.iter().map(|c| c.dot(n));
+            let (clo, chi) = dots.fold((f64::MAX, f64::MIN), |(a, b), d| (a.min(d), b.max(d)));
+            assert!((lo - clo).abs() < 1e-12 && (hi - chi).abs() < 1e-12, "{n}");
+        }
+        let b = tube().bounds();
+        for (i, n) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+            assert_eq!(tube().support(n), (b.min[i], b.max[i]));
+        }
+        // The tube along its own axis reaches half its length, across it its radius.
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        let c = DVec3::new(1.0, -2.0, 0.5).dot(axis);
+        assert_eq!(tube().support(axis), (c - 3.0, c + 3.0));
     }
 }

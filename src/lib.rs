@@ -8,9 +8,11 @@
 pub mod accel;
 pub mod bench;
 pub mod cli;
+pub mod count;
 pub mod detector;
 pub mod estimator;
 pub mod geometry;
+pub mod input_file;
 pub mod optics;
 pub mod optimize;
 pub mod output;

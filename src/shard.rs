@@ -15,9 +15,10 @@
 use crate::optics::surface::Estimator;
 use crate::output::atomic::OutputSet;
 use crate::run::metrics::ScoredBins;
-use crate::run::{ConvergenceRow, RunOptions, RunResult, Shard, StoppedBy, metrics};
+use crate::run::{ConvergenceRow, MAX_SHARDS, RunOptions, RunResult, Shard, StoppedBy, metrics};
 use crate::scene::Scene;
 use crate::tally::Tally;
+use crate::tracer::CHUNK;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -38,7 +39,7 @@ pub struct ShardFile {
     pub version: u32,
     /// Scene name.
     pub scene: String,
-    /// Scene file as given to `trace`.
+    /// Scene file, absolute (shards written before 0.1 hold the path given to `trace`).
     pub scene_file: PathBuf,
     /// [`Scene::content_hash`], hex.
     pub scene_hash: String,
@@ -71,7 +72,9 @@ pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
         format: FORMAT.into(),
         version: FORMAT_VERSION,
         scene: result.scene.name.clone(),
-        scene_file: result.scene.path.clone(),
+        // Absolute, so `merge` finds it from any folder.
+        scene_file: std::path::absolute(&result.scene.path)
+            .unwrap_or_else(|_| result.scene.path.clone()),
         scene_hash: format!("{:016x}", result.scene.content_hash()),
         seed: o.seed,
         photons: o.photons,
@@ -96,8 +99,7 @@ pub fn read_shard(path: &Path) -> Result<ShardFile> {
     } else {
         path.to_path_buf()
     };
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("{}: cannot read shard file", path.display()))?;
+    let text = crate::input_file::read_text(&path, "shard file")?;
     let f: ShardFile = serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}: not a shard file: {e}", path.display()))?;
     if f.format != FORMAT || f.version != FORMAT_VERSION {
@@ -106,6 +108,15 @@ pub fn read_shard(path: &Path) -> Result<ShardFile> {
             path.display(),
             f.format,
             f.version
+        );
+    }
+    let sh = f.shard;
+    if sh.count == 0 || sh.index >= sh.count || sh.count > MAX_SHARDS {
+        bail!(
+            "{}: shard: {}/{} is no shard of a run (need 0 <= K < M <= {MAX_SHARDS})",
+            path.display(),
+            sh.index,
+            sh.count
         );
     }
     Ok(f)
@@ -183,7 +194,8 @@ pub fn check(shards: &[(PathBuf, ShardFile)], scene: &Scene) -> Result<Vec<u64>>
 /// Merge checked shards of `scene` into one result, as a single run would have produced.
 pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<RunResult<'a>> {
     let first = &shards.first().context("no shards to merge")?.1;
-    let mut groups = vec![Tally::new(scene); metrics::GROUPS];
+    let empty = Tally::new(scene);
+    let mut groups = vec![empty.clone(); metrics::GROUPS];
     for (p, s) in shards {
         if s.groups.len() != groups.len() {
             bail!(
@@ -193,15 +205,15 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
                 groups.len()
             );
         }
-        for (g, sg) in groups.iter_mut().zip(&s.groups) {
-            if sg.flux.bins.len() != g.flux.bins.len()
-                || sg.angular.bins.len() != g.angular.bins.len()
-            {
+        for (k, sg) in s.groups.iter().enumerate() {
+            if let Some(why) = sg.inconsistency(&empty, group_photons(s, k)) {
                 bail!(
-                    "{}: tally shape does not match the scene's detector",
+                    "{}: groups[{k}]: {why}: a damaged or edited shard file",
                     p.display()
                 );
             }
+        }
+        for (g, sg) in groups.iter_mut().zip(&s.groups) {
             g.merge(sg);
         }
     }
@@ -225,8 +237,9 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
             estimator: first.estimator,
             ..RunOptions::default()
         },
-        // All worker threads of all shards; runtime_s likewise sums the shards' times.
-        threads: shards.iter().map(|(_, s)| s.threads).sum(),
+        // The threads of one shard (the most any used): each shard is its own process, so
+        // a sum would be no machine's; runtime_s sums the shards' times (CPU-like).
+        threads: shards.iter().map(|(_, s)| s.threads).max().unwrap_or(1),
         tally: total,
         groups,
         runtime_s,
@@ -234,6 +247,25 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
         history: vec![row],
         leave_out: e.leave_out,
     })
+}
+
+/// Photons of group `k` in shard `s`: chunk `c` of its range scores into group
+/// `c mod GROUPS`; the chunks at the range's ends may be cut short (in closed form, so
+/// any range a file claims costs nothing to check).
+fn group_photons(s: &ShardFile, k: usize) -> u64 {
+    let [first, last] = s.range.map(u128::from);
+    let (g, k, chunk) = (metrics::GROUPS as u128, k as u128, u128::from(CHUNK));
+    let (c0, c1) = (first / chunk, last.div_ceil(chunk));
+    // Chunks c < x with c = k (mod g).
+    let below = |x: u128| if x > k { (x - k - 1) / g + 1 } else { 0 };
+    let mut n = (below(c1) - below(c0)) * chunk;
+    if c1 > c0 && (c1 - 1) % g == k {
+        n -= c1 * chunk - last;
+    }
+    if c1 > c0 && c0 % g == k {
+        n -= first - c0 * chunk;
+    }
+    n as u64
 }
 
 fn backend_name(names: &[&str]) -> &'static str {

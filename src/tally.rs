@@ -191,6 +191,14 @@ impl TryFrom<SparseGrid> for Grid {
     type Error = String;
 
     fn try_from(s: SparseGrid) -> Result<Self, String> {
+        // A stored grid is never larger than a run's tally budget allows; checked before
+        // allocating, so a damaged file is an error, not an allocation abort.
+        if s.nx.checked_mul(s.ny).is_none_or(|n| n > 1 << 26) {
+            return Err(format!(
+                "a {}x{} grid is larger than any run tallies",
+                s.nx, s.ny
+            ));
+        }
         let mut g = Grid::new(s.nx, s.ny);
         for (i, sum, sumsq, hits) in s.bins {
             let bin = g
@@ -380,6 +388,53 @@ impl Tally {
                 scene.sources.list.len(),
             ),
         }
+    }
+
+    /// What makes this tally one no run of `photons` photons of the scene `empty` was made
+    /// for ([`Tally::new`]) could have scored, if anything: another shape (bins, tags,
+    /// media, sources), another photon count, emitted weight other than one per photon,
+    /// books that do not close, or a sink holding negative weight. Shard files are checked
+    /// with it before they are merged, so an edited or damaged one is refused.
+    pub fn inconsistency(&self, empty: &Tally, photons: u64) -> Option<String> {
+        let l = &self.ledger;
+        let shape = |t: &Tally| {
+            let l = &t.ledger;
+            [
+                (t.flux.nx, t.flux.ny, t.flux.bins.len()),
+                (t.angular.nx, t.angular.ny, t.angular.bins.len()),
+                (
+                    l.hits_by_tag.len(),
+                    l.feature_hits_by_tag.len(),
+                    l.absorbed_by_surface.len(),
+                ),
+                (l.absorbed_in_medium.len(), l.absorbed_by_source.len(), 0),
+            ]
+        };
+        let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
+        let negative = sinks
+            .chain(&l.absorbed_by_source)
+            .chain([&l.escaped, &l.killed, &l.detected.sum])
+            .any(|s| s.0 < 0);
+        Some(if shape(self) != shape(empty) {
+            "tally shape does not match the scene's detector, tags, media or sources".into()
+        } else if l.photons != photons {
+            format!("{} photons, but its range holds {photons}", l.photons)
+        } else if l.emitted.0 != i128::from(photons) << FRACTION_BITS {
+            format!(
+                "emitted weight {} for {photons} photons of weight 1",
+                l.emitted.value()
+            )
+        } else if l.accounted() != l.emitted {
+            format!(
+                "the ledger does not balance: emitted {} but accounted {}",
+                l.emitted.value(),
+                l.accounted().value()
+            )
+        } else if negative || l.detected.hits > photons || l.killed_photons > photons {
+            "a sink holds negative weight, or more photons than were emitted".into()
+        } else {
+            return None;
+        })
     }
 
     /// Add another tally of the same scene.

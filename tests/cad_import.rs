@@ -521,3 +521,45 @@ fn check_prints_sizes_and_json() {
     assert_eq!(g["triangles"], 12);
     assert_eq!(g["tags"]["lgp"]["bounds_mm"]["max"][0], 125.0);
 }
+
+/// A glTF node that is its own ancestor is an error naming the node, not a stack
+/// overflow; so is a chain of nodes deeper than any CAD export nests.
+#[test]
+fn gltf_node_cycles_and_runaway_depth_are_errors() {
+    let (json, bin) = gltf(&part());
+    let scene_dir = |name: &str, json: &str| {
+        let path = write_scene(name, &scene_toml("file = \"part.gltf\""), &[]);
+        let dir = path.parent().unwrap().to_path_buf();
+        std::fs::write(dir.join("part.gltf"), json).unwrap();
+        std::fs::write(dir.join("part.bin"), &bin).unwrap();
+        path
+    };
+    let cycle = json.replace(
+        r#""nodes":[{"mesh":0}]"#,
+        r#""nodes":[{"mesh":0,"children":[1]},{"children":[0]}]"#,
+    );
+    assert_ne!(cycle, json);
+    let path = scene_dir("gltf-cycle", &cycle);
+    let err = format!("{:#}", Scene::load(&path).err().expect("a cycle loaded"));
+    assert!(
+        err.contains("part.gltf") && err.contains("own ancestor"),
+        "{err}"
+    );
+
+    let chain: Vec<String> = (0..400)
+        .map(|i| match i {
+            399 => r#"{"mesh":0}"#.to_string(),
+            _ => format!(r#"{{"children":[{}]}}"#, i + 1),
+        })
+        .collect();
+    let deep = json.replace(
+        r#""nodes":[{"mesh":0}]"#,
+        &format!(r#""nodes":[{}]"#, chain.join(",")),
+    );
+    let path = scene_dir("gltf-deep", &deep);
+    let err = format!(
+        "{:#}",
+        Scene::load(&path).err().expect("a 400-deep chain loaded")
+    );
+    assert!(err.contains("deeper than 256"), "{err}");
+}

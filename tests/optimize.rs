@@ -301,10 +301,7 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
             frac >= min * 0.999 && frac <= max
         }));
         // The written scene traces as it is, with the new density.
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!("blutrace-opt-out-{method}-"))
-            .tempdir()
-            .unwrap();
+        let tmp = support::temp_folder(&format!("opt-out-{method}"));
         let out = tmp.path().join("out");
         let files = r.write(&out).unwrap();
         for f in [

@@ -1,5 +1,7 @@
 //! Sharded runs as separate processes, merged, equal one process bit for bit.
 
+mod support;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -24,10 +26,7 @@ fn ok(args: &[&str]) {
 
 /// A fresh temporary folder, removed on drop.
 fn tmp(name: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("blutrace-shards-{name}-"))
-        .tempdir()
-        .unwrap()
+    support::temp_folder(&format!("shards-{name}"))
 }
 
 fn shard(dir: &Path, k: usize, m: usize, seed: &str) -> String {
@@ -54,6 +53,12 @@ fn summary_without_timing(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let o = v.as_object_mut().unwrap();
+    // Shards record the scene by absolute path (so `merge` works from any folder): the
+    // merged run names the same file.
+    let file = o.remove("scene_file").unwrap();
+    let file = std::fs::canonicalize(file.as_str().unwrap()).unwrap();
+    let scene = std::fs::canonicalize(SCENE).unwrap().join("scene.toml");
+    assert_eq!(file, scene);
     for k in [
         "runtime_s",
         "photons_per_s",
@@ -134,5 +139,56 @@ fn missing_duplicate_and_foreign_shards_are_errors() {
         String::from_utf8_lossy(&mixed.stderr).contains("seed is 10"),
         "{}",
         String::from_utf8_lossy(&mixed.stderr)
+    );
+}
+
+/// `merge` never writes into a folder that is or holds one of its shards (the set would
+/// replace the folder and delete the shard); it merges from any folder (shards record
+/// the scene by absolute path); an edited shard tally is refused.
+#[test]
+fn merge_keeps_its_inputs_and_checks_their_tallies() {
+    let tmp = tmp("inputs");
+    let dir = tmp.path();
+    let shards: Vec<String> = (0..2).map(|k| shard(dir, k, 2, "3")).collect();
+    for out in [shards[0].clone(), dir.to_string_lossy().into_owned()] {
+        let run = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+            .args(["merge", &shards[0], &shards[1], "--out", &out])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "merged into {out}");
+        assert!(err.contains("would delete"), "{err}");
+        assert!(
+            Path::new(&shards[0]).join("shard.json").is_file(),
+            "shard 0 lost"
+        );
+    }
+    let merged = dir.join("merged");
+    let run = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args(["merge", &shards[0], &shards[1], "--quiet", "--out"])
+        .arg(&merged)
+        .current_dir(std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let file = Path::new(&shards[1]).join("shard.json");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["groups"][0]["ledger"]["photons"] = serde_json::json!(5);
+    std::fs::write(&file, serde_json::to_vec(&v).unwrap()).unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args(["merge", &shards[0], &shards[1], "--out"])
+        .arg(dir.join("edited"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "an edited shard merged");
+    assert!(
+        err.contains("groups[0]") && err.contains("5 photons"),
+        "{err}"
     );
 }

@@ -76,9 +76,9 @@ pub(super) fn bench(
     println!("|---|---|---:|---:|---:|---:|---:|");
     for r in rows {
         println!(
-            "| {} | {:?} | {} | {:.2e} | {:.3} | {:.3e} | {:.3e} |",
+            "| {} | {} | {} | {:.2e} | {:.3} | {:.3e} | {:.3e} |",
             r.backend,
-            r.estimator,
+            super::word(&r.estimator),
             r.photons,
             r.mean_rel_error,
             r.bin_rel_error,

@@ -8,6 +8,7 @@ mod enums;
 pub mod optimize;
 mod trace;
 
+use crate::run::Interrupt;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -33,7 +34,7 @@ enum Command {
     /// Measure photons/s per backend (ratios in one run; see the README's table).
     Bench {
         /// Photons per configuration.
-        #[arg(long, default_value_t = 200_000)]
+        #[arg(long, default_value_t = 200_000, value_parser = crate::count::parse_photons)]
         photons: u64,
         /// Worker threads (default: all cores).
         #[arg(long)]
@@ -64,7 +65,7 @@ enum Command {
 pub fn main() -> ExitCode {
     quiet_on_broken_pipe();
     match Cli::parse().command.execute() {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
@@ -93,9 +94,9 @@ fn quiet_on_broken_pipe() {
 }
 
 impl Command {
-    fn execute(self) -> Result<()> {
-        match self {
-            Command::Trace(args) => trace::trace(args),
+    fn execute(self) -> Result<ExitCode> {
+        let done = match self {
+            Command::Trace(args) => return trace::trace(args),
             Command::Merge(args) => trace::merge(args),
             Command::Optimize(args) => optimize::run(*args),
             Command::Bench {
@@ -110,7 +111,39 @@ impl Command {
                 bench::bench(&scene, &box_scene, photons, threads, repeat)
             }
             Command::Check { scene, json } => check::check(&scene_path(&scene), json),
+        };
+        done.map(|()| ExitCode::SUCCESS)
+    }
+}
+
+/// SIGINT, SIGTERM and SIGHUP ask a run to stop after the chunk it is absorbing: its
+/// outputs then hold what was traced and the command exits 130. A second signal ends the
+/// program at once, leaving the previous output set as it was (sets are all-or-nothing).
+pub(crate) fn stop_on_signals() -> Interrupt {
+    let interrupt = Interrupt::default();
+    let seen = interrupt.clone();
+    let installed = ctrlc::set_handler(move || {
+        if seen.requested() {
+            std::process::exit(130);
         }
+        seen.request();
+        eprintln!(
+            "\ninterrupted: writing what was traced after the current chunk (again to quit at once)"
+        );
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: cannot catch Ctrl-C ({e}): an interrupt ends the run without outputs");
+    }
+    interrupt
+}
+
+/// The name summary.json gives a value (`analog`, `target_error`): the one vocabulary of
+/// the files and the terminal.
+pub(crate) fn word<T: serde::Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(s)) => s,
+        Ok(other) => other.to_string(),
+        Err(_) => "?".into(),
     }
 }
 

@@ -179,6 +179,12 @@ pub fn print_layout_report(r: &LayoutResult) {
             "variable   {} = {} -> {:.4} (range {}..{})",
             v.name, v.initial, v.final_value, v.min, v.max
         );
+        if let Some(end) = v.at_range_end() {
+            println!(
+                "warning    {} ends within 1 % of its range's {end} end: the best design may lie beyond it (widen the range?)",
+                v.name
+            );
+        }
     }
     if let Some(v) = &r.verification {
         println!(

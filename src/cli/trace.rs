@@ -1,17 +1,18 @@
 //! `blutrace trace` and `blutrace merge`: run a scene (or one shard of it), merge shards,
 //! and print the run's report.
 
-use super::{default_out, scene_path};
+use super::{default_out, scene_path, word};
 use crate::accel::BackendChoice;
 use crate::estimator::Estimator;
-use crate::output::atomic::check_dest;
-use crate::run::{self, RunOptions, Shard, TargetMetric};
+use crate::output::atomic::{check_apart, check_dest};
+use crate::run::{self, Progress, RunOptions, Shard, StoppedBy, TargetMetric};
 use crate::scene::Scene;
 use crate::shard;
 use anyhow::Result;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 #[derive(clap::Args)]
 pub(super) struct TraceArgs {
@@ -19,7 +20,7 @@ pub(super) struct TraceArgs {
     scene: PathBuf,
     /// Photons to emit at most (default: the scene's [trace] photons, or 1e9 with
     /// --target-error or --max-time).
-    #[arg(long, visible_alias = "max-photons")]
+    #[arg(long, visible_alias = "max-photons", value_parser = crate::count::parse_photons)]
     photons: Option<u64>,
     /// Stop when the relative standard error of --target-metric is at or below this.
     #[arg(long)]
@@ -71,9 +72,15 @@ pub(super) struct MergeArgs {
     /// Scene file to use (default: the one recorded in the shards).
     #[arg(long)]
     scene: Option<PathBuf>,
+    /// Accepted as by every command (a merge shows no progress bar).
+    #[arg(long)]
+    #[allow(dead_code)]
+    quiet: bool,
 }
 
-pub(super) fn trace(args: TraceArgs) -> Result<()> {
+pub(super) fn trace(args: TraceArgs) -> Result<ExitCode> {
+    // First, so an interrupt while the scene loads is one too.
+    let interrupt = super::stop_on_signals();
     let scene = Scene::load(&scene_path(&args.scene))?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -94,6 +101,7 @@ pub(super) fn trace(args: TraceArgs) -> Result<()> {
         max_time_s: args.max_time,
         shard: args.shard,
         convex: !args.no_convex,
+        interrupt,
     };
     let out = args.out.unwrap_or_else(|| default_out(&scene.name));
     // A folder the run could not replace is refused before tracing, not after.
@@ -104,8 +112,16 @@ pub(super) fn trace(args: TraceArgs) -> Result<()> {
     };
     check_dest(&out, names)?;
     let (first, last) = options.photon_range();
-    let bar = progress_bar(last - first, args.quiet);
-    let result = run::trace(&scene, &options, &|n| bar.inc(n))?;
+    let bar = progress_bar(
+        &options,
+        last - first,
+        open_ended && args.photons.is_none(),
+        args.quiet,
+    );
+    let result = run::trace(&scene, &options, &|p| match p {
+        Progress::Chunk(n) => bar.inc(n),
+        Progress::Round { rel_error, .. } => bar.set_message(target_message(&options, rel_error)),
+    })?;
     bar.finish_and_clear();
     if let Some(sh) = args.shard {
         let (first, last) = options.photon_range();
@@ -115,20 +131,111 @@ pub(super) fn trace(args: TraceArgs) -> Result<()> {
             sh.index, sh.count, options.photons, result.runtime_s
         );
         println!("wrote      {}", file.display());
-        return Ok(());
+        return Ok(exit_code(result.stopped_by));
     }
     let files = result.write(&out)?;
     print_report(&result.summary(), &files);
-    Ok(())
+    print_stop_note(&options, &result);
+    Ok(exit_code(result.stopped_by))
 }
 
-fn progress_bar(photons: u64, quiet: bool) -> ProgressBar {
+/// 130 (128 + SIGINT, as a shell reports) for an interrupted run, whose outputs were
+/// written all the same.
+fn exit_code(stopped_by: StoppedBy) -> ExitCode {
+    match stopped_by {
+        StoppedBy::Interrupted => ExitCode::from(130),
+        _ => ExitCode::SUCCESS,
+    }
+}
+
+/// Why an open-ended run ended, when it is not the reason asked for.
+fn print_stop_note(o: &RunOptions, r: &run::RunResult) {
+    let target = o.target_error.map(|e| (e, word(&o.target_metric)));
+    match (r.stopped_by, target) {
+        (StoppedBy::Interrupted, _) => println!(
+            "note       interrupted: the outputs hold the {} photons traced before it",
+            r.tally.ledger.photons
+        ),
+        (StoppedBy::Unreachable, Some((e, m))) => println!(
+            "note       target error {e} of {m} cannot be reached: nothing was detected in {} photons, so the metric and its error are 0/0",
+            r.tally.ledger.photons
+        ),
+        (StoppedBy::Photons | StoppedBy::Time, Some((e, m))) => {
+            let rel = r.summary().figure_of_merit.rel_error;
+            println!(
+                "note       target error {e} of {m} not reached: its relative error is {} after {} photons{}",
+                err(rel, 3, false),
+                r.tally.ledger.photons,
+                if o.target_metric == TargetMetric::Cv {
+                    " (of the debiased cv: a map uniform within its noise has no cv to resolve)"
+                } else {
+                    ""
+                }
+            )
+        }
+        _ => {}
+    }
+}
+
+/// The progress bar on a terminal: photons, elapsed time and a rounded rate; against the
+/// photon budget when that is what ends the run (`open_ended`: a stopping rule and no
+/// --photons), else the time against --max-time and the target metric's error against
+/// --target-error.
+fn progress_bar(o: &RunOptions, photons: u64, open_ended: bool, quiet: bool) -> ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
-    let style = ProgressStyle::with_template("{bar:40} {pos}/{len} photons  {per_sec}  eta {eta}")
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-    ProgressBar::new(photons).with_style(style)
+    let template = if open_ended {
+        "{spinner} {pos} photons  {elapsed}{limit}  {rate}  {msg}"
+    } else {
+        "{bar:40} {pos}/{len} photons  {elapsed} elapsed  {rate}  eta {eta}  {msg}"
+    };
+    let max_time = o.max_time_s;
+    let style = ProgressStyle::with_template(template)
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .with_key("rate", |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{} photons/s", three_digits(s.per_sec()));
+        })
+        .with_key(
+            "limit",
+            move |_: &ProgressState, w: &mut dyn std::fmt::Write| {
+                if let Some(t) = max_time {
+                    let _ = write!(w, " of {t} s");
+                }
+            },
+        );
+    let bar = ProgressBar::new(photons).with_style(style);
+    bar.set_message(target_message(o, f64::NAN));
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    bar
+}
+
+/// `rel. error 0.034 (target 0.01) of mean`, as the last round left it.
+fn target_message(o: &RunOptions, rel_error: f64) -> String {
+    match o.target_error {
+        Some(target) => format!(
+            "rel. error {} (target {target}) of {}",
+            if rel_error.is_finite() {
+                format!("{rel_error:.3}")
+            } else {
+                "-".into()
+            },
+            word(&o.target_metric)
+        ),
+        None => String::new(),
+    }
+}
+
+/// A rate with three significant digits (`123000`, `1.23e+06` past a million).
+fn three_digits(x: f64) -> String {
+    if !x.is_finite() || x <= 0.0 {
+        "-".into()
+    } else if x < 1e6 {
+        let digits = (2 - x.log10().floor() as i32).max(0) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.2e}")
+    }
 }
 
 fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
@@ -139,8 +246,13 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     let lamps = l.absorbed_by_source_w.values().sum::<f64>();
     println!("scene      {} ({})", s.scene, s.scene_file);
     println!(
-        "traced     {} photons, seed {}, backend {}, estimator {:?}, {} threads; stopped by {:?}",
-        s.photons, s.seed, s.backend, s.estimator, s.threads, s.stopped_by
+        "traced     {} photons, seed {}, backend {}, estimator {}, {} threads; stopped by {}",
+        s.photons,
+        s.seed,
+        s.backend,
+        word(&s.estimator),
+        s.threads,
+        word(&s.stopped_by)
     );
     println!(
         "time       {:.2} s  ({:.0} photons/s, {:.0} interactions/s)",
@@ -192,10 +304,10 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         );
     }
     println!(
-        "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {} ({:?})",
+        "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {} ({})",
         s.mean_rel_stderr,
         err(s.figure_of_merit.per_s, 3, true),
-        s.figure_of_merit.metric
+        word(&s.figure_of_merit.metric)
     );
     if let Some(lum) = &s.luminance {
         println!(
@@ -246,6 +358,8 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
         );
     }
     check_dest(&args.out, run::OUTPUT_NAMES)?;
+    let inputs: Vec<&std::path::Path> = args.shards.iter().map(PathBuf::as_path).collect();
+    check_apart(&args.out, &inputs)?;
     let result = shard::merge(&shards, &scene)?;
     let files = result.write(&args.out)?;
     print_report(&result.summary(), &files);

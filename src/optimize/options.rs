@@ -51,7 +51,7 @@ pub struct OptimizeOptions {
     #[arg(long, default_value_t = 7)]
     pub grid_points: usize,
     /// Photons per evaluated design.
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::count::parse_photons)]
     pub photons: u64,
     /// Seed shared by every evaluation (common random numbers); `blutrace optimize
     /// --seed`, whose default is the scene's `trace.seed`, sets it.
@@ -62,7 +62,8 @@ pub struct OptimizeOptions {
     #[arg(
         long,
         default_value_t = 60,
-        default_value_if("method", "feedback", "15")
+        default_value_if("method", "feedback", "15"),
+        hide_default_value = true
     )]
     pub max_iter: usize,
     /// Stop once the objective (cv of the profile along the axis) is at or below this.
@@ -110,7 +111,7 @@ pub struct OptimizeOptions {
     pub edge_margin_mm: f64,
     /// Photons of the verification re-traces of the first and final design (0: none; the
     /// optimization's own traces of the first and best design are reported instead).
-    #[arg(long, default_value_t = 10_000_000)]
+    #[arg(long, default_value_t = 10_000_000, value_parser = crate::count::parse_count)]
     pub verify_photons: u64,
     /// Seed of the verification re-traces (default: one no evaluation used).
     #[arg(long)]

@@ -245,6 +245,43 @@ pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
     Ok(())
 }
 
+/// Refuse an output folder that is, or holds, one of a command's `inputs` (files or
+/// folders it reads, such as the shards of a merge): committing the set would replace the
+/// folder and so delete the input. Paths are compared resolved (symbolic links, `..`), a
+/// folder that does not exist yet by its nearest existing ancestor.
+pub fn check_apart(dest: &Path, inputs: &[&Path]) -> Result<()> {
+    let out = resolved(dest);
+    for input in inputs {
+        if resolved(input).starts_with(&out) {
+            bail!(
+                "{}: is or holds the input {}, which writing the outputs there would delete; give --out another folder",
+                dest.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `p` made absolute with every existing part resolved (the rest appended as written).
+fn resolved(p: &Path) -> PathBuf {
+    let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let mut missing = Vec::new();
+    let mut at = abs.as_path();
+    loop {
+        if let Ok(real) = fs::canonicalize(at) {
+            return missing.iter().rev().fold(real, |acc, part| acc.join(part));
+        }
+        match (at.parent(), at.file_name()) {
+            (Some(parent), Some(name)) => {
+                missing.push(name.to_owned());
+                at = parent;
+            }
+            _ => return abs,
+        }
+    }
+}
+
 /// The entries named by `dir`'s manifest (none without one).
 fn manifest_entries(dir: &Path) -> Vec<String> {
     let Ok(text) = fs::read_to_string(dir.join(MANIFEST)) else {

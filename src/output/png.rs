@@ -385,7 +385,7 @@ fn draw_mm_axes(canvas: &mut Canvas, l: &Layout, ex: f64, ey: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::test_png::{TempFile, decode};
+    use crate::output::test_png::{TempFile, decode, preview_path};
 
     fn pixel(img: &(u32, u32, Vec<u8>), x: usize, y: usize) -> [u8; 3] {
         let i = 3 * (y * img.0 as usize + x);
@@ -479,7 +479,7 @@ mod tests {
     }
 
     #[test]
-    #[ignore = "writes /tmp/blutrace_preview_*.png for a visual check"]
+    #[ignore = "writes blutrace_preview_*.png to the temporary folder for a visual check"]
     fn demo_preview() {
         let (w, h) = (64, 40);
         let mut v: Vec<f64> = (0..w * h)
@@ -490,7 +490,7 @@ mod tests {
             .collect();
         v[0] = f64::NAN; // bottom-left bin grey
         write_false_colour(
-            Path::new("/tmp/blutrace_preview_demo.png"),
+            &preview_path("blutrace_preview_demo.png"),
             w,
             h,
             &v,
@@ -504,7 +504,7 @@ mod tests {
             ..PreviewOptions::default()
         };
         write_false_colour(
-            Path::new("/tmp/blutrace_preview_small.png"),
+            &preview_path("blutrace_preview_small.png"),
             5,
             3,
             &small,

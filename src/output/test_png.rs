@@ -27,3 +27,12 @@ pub(crate) fn decode(path: &Path) -> (u32, u32, Vec<u8>) {
     buf.truncate(info.buffer_size());
     (info.width, info.height, buf)
 }
+
+/// Where a visual-check test (`#[ignore]`, run by hand) writes a picture to look at:
+/// `$BLUTRACE_PREVIEW_DIR/name`, or the temporary folder when that is not set.
+pub(crate) fn preview_path(name: &str) -> PathBuf {
+    std::env::var_os("BLUTRACE_PREVIEW_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(std::env::temp_dir)
+        .join(name)
+}

@@ -40,6 +40,8 @@ use metrics::{GROUPS, Map, Metric, MetricValues};
 use rounds::Rounds;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// The metric a `--target-error` refers to.
@@ -51,7 +53,9 @@ pub enum TargetMetric {
     Mean,
     /// Detected over emitted power.
     Efficiency,
-    /// Coefficient of variation of the flux map.
+    /// Coefficient of variation of the flux map, debiased (its noise floor removed in
+    /// quadrature): the raw cv of a short run is mostly noise, and its error would say
+    /// nothing of the backlight's.
     Cv,
     /// 9-point min/max.
     NinePoint,
@@ -67,7 +71,7 @@ impl TargetMetric {
         match self {
             TargetMetric::Mean => Metric::Mean,
             TargetMetric::Efficiency => Metric::Efficiency,
-            TargetMetric::Cv => Metric::Cv,
+            TargetMetric::Cv => Metric::CvDebiased,
             TargetMetric::NinePoint => Metric::NinePoint,
             TargetMetric::ThirteenPoint => Metric::ThirteenPoint,
             TargetMetric::Bin => Metric::MeanRelStderr,
@@ -98,7 +102,13 @@ pub struct RunOptions {
     pub shard: Option<Shard>,
     /// Use the convex-solid fast path where a scene allows it.
     pub convex: bool,
+    /// Ends the run early when requested.
+    pub interrupt: Interrupt,
 }
+
+/// Most shards one run may be split into: far more than any cluster job, few enough that
+/// a merge's bookkeeping of them is small (a shard file claiming more is damaged).
+pub const MAX_SHARDS: u64 = 1 << 20;
 
 /// Shard `index` of `count`: a contiguous run of whole chunks of the photon indices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -123,18 +133,19 @@ impl Shard {
                 .parse()
                 .with_context(|| format!("--shard {s}: M is not a number"))?,
         );
-        if count == 0 || index >= count {
-            bail!("--shard {s}: need 0 <= K < M");
+        if count == 0 || index >= count || count > MAX_SHARDS {
+            bail!("--shard {s}: need 0 <= K < M <= {MAX_SHARDS}");
         }
         Ok(Shard { index, count })
     }
 
-    /// The photon indices this shard traces out of `0..photons`.
+    /// The photon indices this shard traces out of `0..photons` (in u128, so no count
+    /// up to `u64::MAX` overflows).
     pub fn range(&self, photons: u64) -> (u64, u64) {
-        let chunks = photons.div_ceil(CHUNK);
-        let first = chunks * self.index / self.count;
-        let last = chunks * (self.index + 1) / self.count;
-        ((first * CHUNK).min(photons), (last * CHUNK).min(photons))
+        let chunks = u128::from(photons.div_ceil(CHUNK));
+        let (k, m) = (u128::from(self.index), u128::from(self.count));
+        let at = |chunk: u128| (chunk * u128::from(CHUNK)).min(u128::from(photons)) as u64;
+        (at(chunks * k / m), at(chunks * (k + 1) / m))
     }
 }
 
@@ -159,6 +170,7 @@ impl Default for RunOptions {
             max_time_s: None,
             shard: None,
             convex: true,
+            interrupt: Interrupt::default(),
         }
     }
 }
@@ -171,8 +183,37 @@ pub enum StoppedBy {
     Photons,
     /// The target error was reached.
     TargetError,
-    /// The time budget was spent.
+    /// The time budget was spent (checked after every chunk).
     Time,
+    /// Interrupted ([`Interrupt::request`], Ctrl-C): the outputs hold what was traced.
+    Interrupted,
+    /// The target error cannot be reached: the target metric's error was still 0/0
+    /// (nothing detected) after [`UNREACHABLE_AFTER`] photons.
+    Unreachable,
+}
+
+/// Photons after which a target metric whose relative error is still 0/0 (no photon
+/// detected, so neither the metric nor its error is defined) stops a `--target-error` run
+/// as [`StoppedBy::Unreachable`] instead of tracing on to the photon cap: about 1e6, where
+/// a detector that catches one photon in 3e5 has caught one with 95 % probability.
+pub const UNREACHABLE_AFTER: u64 = 1 << 20;
+
+/// A request to end a run early, shared between the run and whoever may ask (a signal
+/// handler, a GUI's stop button): the run stops after the chunk it is absorbing and its
+/// result holds every photon traced so far.
+#[derive(Clone, Debug, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+impl Interrupt {
+    /// Ask the runs holding this interrupt to stop.
+    pub fn request(&self) {
+        self.0.store(true, Ordering::Release);
+    }
+
+    /// Whether a stop was asked for.
+    pub fn requested(&self) -> bool {
+        self.0.load(Ordering::Acquire)
+    }
 }
 
 /// One row of the convergence history, taken after a round.
@@ -244,11 +285,26 @@ pub fn check_tally_budget(scene: &Scene) -> Result<u64> {
 /// depend on the count), few enough that starting them cannot exhaust the machine.
 pub const MAX_THREADS: usize = 1024;
 
-/// Trace `scene` as `options` say. `progress` receives photon counts as chunks finish.
+/// What a run tells its observer while it traces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Progress {
+    /// A chunk of this many photons was added to the tallies.
+    Chunk(u64),
+    /// A round ended: its convergence row was recorded.
+    Round {
+        /// Photons traced so far.
+        photons: u64,
+        /// The `--target-error` metric's relative standard error now (NaN without a
+        /// target, or while it is undefined).
+        rel_error: f64,
+    },
+}
+
+/// Trace `scene` as `options` say. `progress` hears of every chunk and round.
 pub fn trace<'a>(
     scene: &'a Scene,
     options: &RunOptions,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RunResult<'a>> {
     trace_reusing(scene, options, &mut MeshBuildCache::default(), progress)
 }
@@ -259,7 +315,7 @@ pub fn trace_reusing<'a>(
     scene: &'a Scene,
     options: &RunOptions,
     builds: &mut MeshBuildCache,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RunResult<'a>> {
     if let Some(e) = options.target_error
         && !(e > 0.0 && e.is_finite())
@@ -267,9 +323,12 @@ pub fn trace_reusing<'a>(
         bail!("--target-error must be a positive number, got {e}");
     }
     if let Some(t) = options.max_time_s
-        && !(t >= 0.0 && t.is_finite())
+        && !(t > 0.0 && t.is_finite())
     {
-        bail!("--max-time must be a finite number of seconds >= 0, got {t}");
+        bail!("--max-time must be a finite number of seconds > 0, got {t}");
+    }
+    if options.photons == 0 {
+        bail!("--photons must be at least 1: a run of no photons has nothing to report");
     }
     if let Some(n) = options.threads
         && !(1..=MAX_THREADS).contains(&n)
@@ -277,6 +336,16 @@ pub fn trace_reusing<'a>(
         bail!("--threads must be within 1..={MAX_THREADS}, got {n}");
     }
     check_tally_budget(scene)?;
+    if options.target_error.is_some()
+        && options.target_metric == TargetMetric::Cv
+        && scene.detector.bins[0] * scene.detector.bins[1] == 1
+    {
+        bail!(
+            "{}: detector.bins is [1, 1]: the cv of a one-bin map is 0 by construction, so \
+             --target-metric cv can never reach a relative error",
+            scene.path.display()
+        );
+    }
     if options.shard.is_some() && (options.target_error.is_some() || options.max_time_s.is_some()) {
         bail!("a shard traces a fixed photon range: --target-error and --max-time do not apply");
     }

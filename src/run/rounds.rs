@@ -18,10 +18,11 @@
 //! end no longer leaves all but one worker idle (with many threads, most of them).
 
 use super::metrics::{self, GROUPS, MetricValues, ScoredBins};
-use super::{ConvergenceRow, RunOptions, StoppedBy, relative_error};
+use super::{ConvergenceRow, Progress, RunOptions, StoppedBy, UNREACHABLE_AFTER, relative_error};
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Tally};
 use crate::tracer::{CHUNK, Tracer};
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::sync::{Condvar, Mutex};
@@ -139,10 +140,10 @@ impl Rounds {
         scene: &Scene,
         o: &RunOptions,
         start: Instant,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: &(dyn Fn(Progress) + Sync),
     ) -> StoppedBy {
-        if let Some(why) = self.stop_reason(o, start.elapsed().as_secs_f64()) {
-            return why;
+        if self.traced >= self.last {
+            return StoppedBy::Photons;
         }
         let end = self.next_round_end(o, start.elapsed().as_secs_f64());
         let gate = Gate {
@@ -168,8 +169,10 @@ impl Rounds {
         })
     }
 
-    /// The calling thread's part of [`Rounds::run`]: absorb chunks as they arrive, record
-    /// each round as it completes, until a rule stops the run.
+    /// The calling thread's part of [`Rounds::run`]: absorb chunks in index order as
+    /// they arrive (holding any that come early), record each round as it completes, until
+    /// a rule stops the run. In index order, the tallies always hold a whole prefix of the
+    /// run's photons, so an interrupt or the time budget can end the run after any chunk.
     #[allow(clippy::too_many_arguments)]
     fn absorb_rounds(
         &mut self,
@@ -180,44 +183,56 @@ impl Rounds {
         mut end: u64,
         gate: &Gate,
         rx: &Receiver<ChunkTally>,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: &(dyn Fn(Progress) + Sync),
     ) -> StoppedBy {
-        let mut ahead: Vec<ChunkTally> = Vec::new();
-        let mut end_chunk = end.div_ceil(CHUNK);
-        let mut missing = end_chunk - self.traced / CHUNK;
+        let mut early: BTreeMap<u64, ChunkTally> = BTreeMap::new();
+        let mut next = self.traced / CHUNK;
         loop {
-            while missing == 0 {
-                self.traced = end;
-                let seconds = start.elapsed().as_secs_f64();
-                let recording = Instant::now();
-                if end == self.last {
-                    // No chunk is left to trace: the workers are free to share the
-                    // jackknife (asking them earlier would wait for their chunks).
-                    pool.install(|| self.record(scene, seconds));
-                } else {
-                    self.record(scene, seconds);
-                }
-                if let Some(why) = self.stop_reason(o, seconds) {
+            while next < end.div_ceil(CHUNK) {
+                let Some(chunk) = early.remove(&next) else {
+                    let chunk = receive(rx, gate, pool.current_num_threads());
+                    early.insert(chunk.index, chunk);
+                    continue;
+                };
+                self.absorb(&chunk, progress);
+                next += 1;
+                if let Some(why) = self.cut_short(o, start) {
+                    self.traced = (next * CHUNK).min(self.last);
+                    self.record(scene, start.elapsed().as_secs_f64());
                     return why;
                 }
-                end = self.next_round_end(o, seconds);
-                end_chunk = end.div_ceil(CHUNK);
-                gate.raise(end_chunk + self.lead(seconds, recording.elapsed().as_secs_f64()));
-                missing = end_chunk - self.traced / CHUNK;
-                let (now, later) = ahead.drain(..).partition(|c| c.index < end_chunk);
-                ahead = later;
-                for chunk in now {
-                    self.absorb(&chunk, progress);
-                    missing -= 1;
-                }
             }
-            let chunk = receive(rx, gate, pool.current_num_threads());
-            if chunk.index < end_chunk {
-                self.absorb(&chunk, progress);
-                missing -= 1;
+            self.traced = end;
+            let seconds = start.elapsed().as_secs_f64();
+            let recording = Instant::now();
+            if end == self.last {
+                // No chunk is left to trace: the workers are free to share the
+                // jackknife (asking them earlier would wait for their chunks).
+                pool.install(|| self.record(scene, seconds));
             } else {
-                ahead.push(chunk);
+                self.record(scene, seconds);
             }
+            progress(Progress::Round {
+                photons: self.traced - self.first,
+                rel_error: self.target_rel_error(o),
+            });
+            if let Some(why) = self.stop_reason(o, seconds) {
+                return why;
+            }
+            end = self.next_round_end(o, seconds);
+            gate.raise(end.div_ceil(CHUNK) + self.lead(seconds, recording.elapsed().as_secs_f64()));
+        }
+    }
+
+    /// A reason to end the run inside a round, after any chunk: an interrupt, or the time
+    /// budget spent.
+    fn cut_short(&self, o: &RunOptions, start: Instant) -> Option<StoppedBy> {
+        if o.interrupt.requested() {
+            return Some(StoppedBy::Interrupted);
+        }
+        match o.max_time_s {
+            Some(t) if start.elapsed().as_secs_f64() >= t => Some(StoppedBy::Time),
+            _ => None,
         }
     }
 
@@ -234,14 +249,25 @@ impl Rounds {
     }
 
     /// Score a traced chunk into its group and the total.
-    fn absorb(&mut self, chunk: &ChunkTally, progress: &(dyn Fn(u64) + Sync)) {
+    fn absorb(&mut self, chunk: &ChunkTally, progress: &(dyn Fn(Progress) + Sync)) {
         let scored = chunk.scored();
         let g = (chunk.index % GROUPS as u64) as usize;
         self.groups[g].absorb_scored(chunk, &scored);
         let bins = &mut self.scored.sets_mut()[g];
         chunk.detections.iter().for_each(|d| bins.mark(d.flux_bin));
         self.total.absorb_scored(chunk, &scored);
-        progress(chunk.ledger.photons);
+        progress(Progress::Chunk(chunk.ledger.photons));
+    }
+
+    /// The target metric's relative error after the last round (NaN without a target).
+    fn target_rel_error(&self, o: &RunOptions) -> f64 {
+        match (o.target_error, self.history.last()) {
+            (Some(_), Some(row)) => {
+                let m = o.target_metric.metric();
+                relative_error(m, row.values[m], row.stderr[m])
+            }
+            _ => f64::NAN,
+        }
     }
 
     fn stop_reason(&self, o: &RunOptions, elapsed: f64) -> Option<StoppedBy> {
@@ -253,6 +279,10 @@ impl Rounds {
             let rel = relative_error(m, row.values[m], row.stderr[m]);
             if rel <= target {
                 return Some(StoppedBy::TargetError);
+            }
+            let undefined = rel.is_nan() || !(row.values[m] != 0.0 || row.stderr[m] > 0.0);
+            if undefined && self.traced - self.first >= UNREACHABLE_AFTER {
+                return Some(StoppedBy::Unreachable);
             }
         }
         match o.max_time_s {

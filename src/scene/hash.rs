@@ -9,7 +9,7 @@
 
 use super::config::{GeometrySpec, MediumSpec, SceneFile, SourceSpec, SurfaceSpec};
 use crate::geometry::Mesh;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -45,8 +45,7 @@ pub(super) fn file_hash(file: &SceneFile, path: &Path) -> Result<u64> {
         } = s
         {
             let table = dir.join(f);
-            let bytes = std::fs::read(&table)
-                .with_context(|| format!("{}: cannot read", table.display()))?;
+            let bytes = crate::input_file::read_bytes(&table, "intensity file")?;
             h.write(&bytes);
         }
     }

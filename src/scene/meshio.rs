@@ -6,6 +6,7 @@
 //! the scene file gives ([`super::geometry_file`]).
 
 use super::geometry_file::Format;
+use crate::input_file::{read_bytes, read_text};
 use anyhow::{Context, Result, bail};
 use glam::{DMat4, DVec3};
 use std::cell::{Cell, RefCell};
@@ -141,8 +142,7 @@ pub fn load(
 const UNTAGGED: &str = "";
 
 fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTriangles> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = read_text(path, "geometry file")?;
     // Material names become tags even when the .mtl file is missing: hand tobj a
     // synthetic material library holding every name used by `usemtl`.
     let mut names: Vec<&str> = text
@@ -192,37 +192,135 @@ fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTr
 }
 
 fn load_gltf(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
-    let (doc, buffers, _) = gltf::import(path)
+    let bytes = read_bytes(path, "geometry file")?;
+    let gltf::Gltf {
+        document: doc,
+        blob,
+    } = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| anyhow::anyhow!("{}: not a valid glTF file: {e}", path.display()))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    for b in doc.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = b.source() {
+            check_buffer_uri(path, base, b.index(), uri)?;
+        }
+    }
+    // Buffers only: images (textures) are no optics and are never read.
+    let buffers = gltf::import_buffers(&doc, Some(base), blob)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read its buffers: {e}", path.display()))?;
     let scene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
         .with_context(|| format!("{}: glTF file has no scene", path.display()))?;
     let mut out = TaggedTriangles::default();
+    let mut walk = NodeWalk {
+        ancestors: Vec::new(),
+        visits: 0,
+        buffers: &buffers,
+        path,
+    };
     for node in scene.nodes() {
-        walk_node(&node, transform, &buffers, path, &mut out)?;
+        walk.node(&node, transform, &mut out)?;
     }
     Ok(out)
 }
 
-fn walk_node(
-    node: &gltf::Node,
-    parent: DMat4,
-    buffers: &[gltf::buffer::Data],
-    path: &Path,
-    out: &mut TaggedTriangles,
-) -> Result<()> {
-    let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-    let world = parent * local;
-    if let Some(mesh) = node.mesh() {
-        for prim in mesh.primitives() {
-            add_primitive(&prim, &mesh, world, buffers, path, out)?;
+/// A glTF buffer's `uri` may embed its data (`data:`) or name a file beside the glTF
+/// file, in its folder or below: never a path that leaves it (`../../etc/passwd`, an
+/// absolute path, a link pointing out), nor another scheme.
+fn check_buffer_uri(path: &Path, base: &Path, index: usize, uri: &str) -> Result<()> {
+    if uri.starts_with("data:") {
+        return Ok(());
+    }
+    let decoded = percent_decoded(uri);
+    let file = base.join(&decoded);
+    let leaves = decoded.starts_with('/') || uri.contains("://");
+    if leaves || crate::input_file::inside(base, &file).is_none() {
+        bail!(
+            "{}: buffers[{index}].uri: must name a file inside the glTF file's folder{}",
+            path.display(),
+            if file.exists() {
+                ""
+            } else {
+                " (and it does not exist)"
+            }
+        );
+    }
+    read_bytes(&file, &format!("buffers[{index}] of {}", path.display())).map(drop)
+}
+
+/// `%XX` escapes of a URI replaced by their bytes (as the glTF loader reads them).
+fn percent_decoded(uri: &str) -> String {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = (b[i] == b'%' && i + 2 < b.len())
+            .then(|| u8::from_str_radix(std::str::from_utf8(&b[i + 1..i + 3]).ok()?, 16).ok())
+            .flatten();
+        match hex {
+            Some(byte) => {
+                out.push(byte);
+                i += 3;
+            }
+            None => {
+                out.push(b[i]);
+                i += 1;
+            }
         }
     }
-    for child in node.children() {
-        walk_node(&child, world, buffers, path, out)?;
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Deepest node hierarchy a glTF file may have: CAD exports nest a few levels per
+/// assembly; deeper is a damaged file, and unbounded depth would overflow the stack.
+const MAX_NODE_DEPTH: usize = 256;
+
+/// Most node instances one glTF scene may place (a node shared by several parents is
+/// placed once per path to it): bounds the work a file of repeated sharing can ask for.
+const MAX_NODE_VISITS: usize = 1 << 20;
+
+/// The walk down a glTF scene's node tree, refusing cycles and unbounded files.
+struct NodeWalk<'a> {
+    /// Indices of the nodes above the current one.
+    ancestors: Vec<usize>,
+    visits: usize,
+    buffers: &'a [gltf::buffer::Data],
+    path: &'a Path,
+}
+
+impl NodeWalk<'_> {
+    fn node(&mut self, node: &gltf::Node, parent: DMat4, out: &mut TaggedTriangles) -> Result<()> {
+        let shown = self.path.display();
+        if self.ancestors.contains(&node.index()) {
+            bail!(
+                "{shown}: nodes[{}]: is its own ancestor (a cycle through `children`)",
+                node.index()
+            );
+        }
+        if self.ancestors.len() >= MAX_NODE_DEPTH {
+            bail!(
+                "{shown}: nodes[{}]: nested deeper than {MAX_NODE_DEPTH} levels",
+                node.index()
+            );
+        }
+        self.visits += 1;
+        if self.visits > MAX_NODE_VISITS {
+            bail!("{shown}: the scene places more than {MAX_NODE_VISITS} node instances");
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                add_primitive(&prim, &mesh, world, self.buffers, self.path, out)?;
+            }
+        }
+        self.ancestors.push(node.index());
+        for child in node.children() {
+            self.node(&child, world, out)?;
+        }
+        self.ancestors.pop();
+        Ok(())
     }
-    Ok(())
 }
 
 fn add_primitive(
@@ -266,7 +364,8 @@ fn add_primitive(
 }
 
 fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let bytes = read_bytes(path, "geometry file")?;
+    check_binary_stl_count(path, &bytes)?;
     let mesh = stl_io::read_stl(&mut std::io::Cursor::new(&bytes))
         .map_err(|e| anyhow::anyhow!("{}: not a valid STL file: {e}", path.display()))?;
     if mesh.faces.is_empty() {
@@ -287,12 +386,39 @@ fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
     Ok(out)
 }
 
+/// A binary STL's triangle count (bytes 80..84) must match its length (84 + 50 per
+/// triangle): a file cut short or with trailing triangles is damaged, not a smaller part.
+/// A file starting `solid` whose length does not fit is read as ASCII STL.
+fn check_binary_stl_count(path: &Path, bytes: &[u8]) -> Result<()> {
+    let Some(count) = bytes.get(80..84) else {
+        return Ok(());
+    };
+    let count = u64::from(u32::from_le_bytes(count.try_into().unwrap_or_default()));
+    let fits = bytes.len() as u64 == 84 + 50 * count;
+    if !fits && !bytes.starts_with(b"solid") {
+        bail!(
+            "{}: binary STL header says {count} triangles, but the file's {} bytes hold {:.1}",
+            path.display(),
+            bytes.len(),
+            (bytes.len() as f64 - 84.0) / 50.0
+        );
+    }
+    Ok(())
+}
+
 fn load_ply(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
     use ply_rs_bw::{parser::Parser, ply::DefaultElement};
-    let file =
-        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let bytes = read_bytes(path, "geometry file")?;
+    // The magic line first: the parser's messages quote the lines it fails on, and a file
+    // that is no PLY (a mistyped path) must not have its contents echoed.
+    if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
+        bail!(
+            "{}: not a PLY file (its first line is not `ply`)",
+            path.display()
+        );
+    }
     let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut BufReader::new(file))
+        .read_ply(&mut BufReader::new(&bytes[..]))
         .map_err(|e| anyhow::anyhow!("{}: not a valid PLY file: {e}", path.display()))?;
     let element = |name: &str| ply.payload.get(name).map(Vec::as_slice).unwrap_or_default();
     let positions = element("vertex")

@@ -75,8 +75,7 @@ pub struct Scene {
 impl Scene {
     /// Load and validate the scene file at `path` and the geometry it names.
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read scene file", path.display()))?;
+        let text = crate::input_file::read_text(path, "scene file")?;
         let file: SceneFile =
             toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         Self::from_file(&file, path)
@@ -137,6 +136,9 @@ impl Scene {
             &sources.list,
         )?;
         let detector = build_detector(&ctx, &file.detector)?;
+        if file.trace.photons == 0 {
+            return Err(ctx.err("trace.photons", "must be at least 1"));
+        }
         if file.trace.max_bounces == 0 {
             return Err(ctx.err("trace.max_bounces", "must be at least 1"));
         }

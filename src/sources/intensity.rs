@@ -86,8 +86,7 @@ struct Read {
 impl IntensityProfile {
     /// Read a profile file by its extension (`.csv` or `.ies`, any case).
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read(path)
-            .map_err(|e| anyhow::anyhow!("{}: cannot read intensity file: {e}", path.display()))?;
+        let text = crate::input_file::read_bytes(path, "intensity file")?;
         // IES files in the wild are often Latin-1: keep what is valid and replace the rest
         // (only keyword lines hold text).
         let text = String::from_utf8_lossy(&text);

@@ -58,12 +58,29 @@ impl AsRef<Path> for SceneDir {
     }
 }
 
+/// A fresh temporary folder named after `label`, removed on drop. The label is made a
+/// plain file name first (letters, digits, `-`, `_`; anything else becomes `-`): a case
+/// label such as "above pi/4" must never name a path under a folder that may not exist.
+pub fn temp_folder(label: &str) -> tempfile::TempDir {
+    let safe: String = label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    tempfile::Builder::new()
+        .prefix(&format!("blutrace-{safe}-"))
+        .tempdir()
+        .unwrap_or_else(|e| panic!("cannot create a temporary folder for {label:?}: {e}"))
+}
+
 /// Write a scene (scene.toml plus named files) into a fresh temporary folder.
 pub fn write_scene(name: &str, toml: &str, files: &[(&str, &str)]) -> SceneDir {
-    let dir = tempfile::Builder::new()
-        .prefix(&format!("blutrace-test-{name}-"))
-        .tempdir()
-        .unwrap();
+    let dir = temp_folder(&format!("test-{name}"));
     for (f, text) in files {
         std::fs::write(dir.path().join(f), text).unwrap();
     }

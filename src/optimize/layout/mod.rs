@@ -38,6 +38,7 @@ use crate::run::RunOptions;
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
 use search::{LayoutSearch, PENALTY};
+use std::collections::HashMap;
 use std::time::Instant;
 use toml::Value;
 
@@ -219,14 +220,36 @@ fn search_case(
         .collect();
     let evaluations = search.history.len();
     let mut case_best: Option<(f64, f64, Vec<f64>)> = None;
+    // Every point asked for, by its scaled coordinates' bits: the simplex may ask for a
+    // point again (a rejected one, or a shrink back onto a vertex); with common random
+    // numbers its objective is the same, so it is neither traced nor reported twice.
+    let mut asked: HashMap<Vec<u64>, f64> = HashMap::new();
     let mut eval = |search: &mut LayoutSearch, z: &[f64]| -> Result<f64> {
-        let x = full(search, z);
+        // Bounds are inclusive as written: a point past an end by rounding (a few ulps of
+        // the scaled coordinate) is that end.
+        let z: Vec<f64> = z
+            .iter()
+            .map(|&z| {
+                if (-BOUND_SLACK..=1.0 + BOUND_SLACK).contains(&z) {
+                    z.clamp(0.0, 1.0)
+                } else {
+                    z
+                }
+            })
+            .collect();
+        let key: Vec<u64> = z.iter().map(|z| z.to_bits()).collect();
+        if let Some(&value) = asked.get(&key) {
+            return Ok(value);
+        }
+        let x = full(search, &z);
         let outside = z.iter().map(|z| (-z).max(z - 1.0)).fold(0.0, f64::max);
         if outside > 0.0 {
             search.reject_out_of_bounds(&x, progress);
+            asked.insert(key, PENALTY + outside);
             return Ok(PENALTY + outside);
         }
         let (value, noise) = search.evaluate(&x, progress)?;
+        asked.insert(key, value);
         if case_best.as_ref().is_none_or(|(b, _, _)| value < *b) {
             case_best = Some((value, noise, x));
         }
@@ -306,6 +329,10 @@ fn search_case(
         termination,
     })
 }
+
+/// How far past a range's end (in the range's unit scale) a point still counts as on it:
+/// far above the rounding of a few steps of the simplex, far below any step it takes.
+const BOUND_SLACK: f64 = 1e-9;
 
 /// The points of a grid of `k` per axis over the unit square (or segment), ends included.
 fn grid(dims: usize, k: usize) -> Vec<Vec<f64>> {

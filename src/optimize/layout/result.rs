@@ -29,6 +29,20 @@ pub struct VariableResult {
     pub integer: bool,
 }
 
+impl VariableResult {
+    /// `"lower"` or `"upper"` when the best design's value of a continuous variable lies
+    /// within 1 % of the range of that end: the optimum may lie beyond it.
+    pub fn at_range_end(&self) -> Option<&'static str> {
+        let margin = 0.01 * (self.max - self.min);
+        match self.integer {
+            true => None,
+            false if self.final_value <= self.min + margin => Some("lower"),
+            false if self.final_value >= self.max - margin => Some("upper"),
+            false => None,
+        }
+    }
+}
+
 /// The search of the continuous variables for one combination of the integer ones.
 #[derive(Clone, Debug, Serialize)]
 pub struct IntegerCase {

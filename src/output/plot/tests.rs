@@ -1,7 +1,7 @@
 //! Tests of the chart writer: geometry of the axes, ticks, legend and the PNG itself.
 
 use super::*;
-use crate::output::test_png::{TempFile, decode};
+use crate::output::test_png::{TempFile, decode, preview_path};
 
 fn pixel(r: &Rendered, x: i64, y: i64) -> [u8; 3] {
     let i = 3 * (y * r.width + x) as usize;
@@ -402,14 +402,14 @@ fn legend_colours_differ() {
 }
 
 #[test]
-#[ignore = "writes /tmp/blutrace_convergence.png and /tmp/blutrace_density.png"]
+#[ignore = "writes blutrace_*.png charts to the temporary folder for a visual check"]
 fn demo_charts() {
     write_chart(
-        Path::new("/tmp/blutrace_convergence.png"),
+        &preview_path("blutrace_convergence.png"),
         &convergence_chart(),
     )
     .unwrap();
-    write_chart(Path::new("/tmp/blutrace_density.png"), &density_chart()).unwrap();
+    write_chart(&preview_path("blutrace_density.png"), &density_chart()).unwrap();
     let glyphs = Chart {
         title: "ABCDEFGHIJKLMNOPQRSTUVWXYZ 0123456789".into(),
         x_label: "abcdefghijklmnopqrstuvwxyz .,-+/()%=:;_'*^<>!?|[]".into(),
@@ -417,7 +417,7 @@ fn demo_charts() {
         series: vec![Series::new("glyph test", vec![(0.0, 1.0), (1.0, 0.0)])],
         ..Chart::default()
     };
-    write_chart(Path::new("/tmp/blutrace_glyphs.png"), &glyphs).unwrap();
+    write_chart(&preview_path("blutrace_glyphs.png"), &glyphs).unwrap();
     let degenerate = Chart {
         title: "Constant y, one lone point, NaN gap".into(),
         x_label: "x".into(),
@@ -438,7 +438,7 @@ fn demo_charts() {
             Series::new("lone point", vec![(0.4, 3.0)]),
         ],
     };
-    write_chart(Path::new("/tmp/blutrace_degenerate.png"), &degenerate).unwrap();
+    write_chart(&preview_path("blutrace_degenerate.png"), &degenerate).unwrap();
     let many = Chart {
         title: "Twelve series, offset data, a title far too long to fit the image width".into(),
         x_label: "x".into(),
@@ -457,5 +457,5 @@ fn demo_charts() {
             .collect(),
         ..Chart::default()
     };
-    write_chart(Path::new("/tmp/blutrace_many.png"), &many).unwrap();
+    write_chart(&preview_path("blutrace_many.png"), &many).unwrap();
 }

@@ -357,9 +357,9 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
             list.join(", ")
         );
     }
-    check_dest(&args.out, run::OUTPUT_NAMES)?;
     let inputs: Vec<&std::path::Path> = args.shards.iter().map(PathBuf::as_path).collect();
     check_apart(&args.out, &inputs)?;
+    check_dest(&args.out, run::OUTPUT_NAMES)?;
     let result = shard::merge(&shards, &scene)?;
     let files = result.write(&args.out)?;
     print_report(&result.summary(), &files);

@@ -540,7 +540,7 @@ fn gltf_node_cycles_and_runaway_depth_are_errors() {
     );
     assert_ne!(cycle, json);
     let path = scene_dir("gltf-cycle", &cycle);
-    let err = format!("{:#}", Scene::load(&path).err().expect("a cycle loaded"));
+    let err = format!("{:#}", Scene::load(&path).expect_err("a cycle loaded"));
     assert!(
         err.contains("part.gltf") && err.contains("own ancestor"),
         "{err}"
@@ -559,7 +559,7 @@ fn gltf_node_cycles_and_runaway_depth_are_errors() {
     let path = scene_dir("gltf-deep", &deep);
     let err = format!(
         "{:#}",
-        Scene::load(&path).err().expect("a 400-deep chain loaded")
+        Scene::load(&path).expect_err("a 400-deep chain loaded")
     );
     assert!(err.contains("deeper than 256"), "{err}");
 }

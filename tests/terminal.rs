@@ -274,7 +274,7 @@ fn unreachable_targets_stop_and_say_so() {
     assert_eq!(s["stopped_by"], "unreachable");
     let photons = s["photons"].as_u64().unwrap();
     assert!(
-        photons >= blutrace::run::UNREACHABLE_AFTER && photons < 4 << 20,
+        (blutrace::run::UNREACHABLE_AFTER..4 << 20).contains(&photons),
         "{photons}"
     );
     assert!(stdout.contains("cannot be reached"), "{stdout}");

@@ -441,3 +441,34 @@ fn a_case_that_cannot_start_from_the_scene_starts_from_a_grid() {
         );
     }
 }
+
+/// An interrupt during a layout search keeps the designs fully traced before it (the one
+/// being traced is dropped), skips the verification and the remaining integer cases, and
+/// writes the whole output set of what it has. Requested after the fourth design.
+#[test]
+fn an_interrupted_layout_search_keeps_what_it_traced() {
+    let dir = two_lamp_box("layout-interrupt", -50.0, 10.0);
+    let scene = load(&dir);
+    let o = OptimizeOptions {
+        verify_photons: 20_000,
+        ..options(
+            &["sources.0.center.0=-58..-2", "sources.1.center.0=2..58"],
+            Method::NelderMead,
+        )
+    };
+    let stop = o.interrupt.clone();
+    let r = optimize_layout(&scene, &o, &mut |e: &EvaluationRecord, _: &[String]| {
+        if e.evaluation == 4 {
+            stop.request();
+        }
+    })
+    .unwrap();
+    assert!(r.interrupted);
+    assert_eq!(r.history.len(), 4, "the fifth design was dropped");
+    assert!(r.verification.is_none());
+    assert!(r.cases[0].termination.contains("interrupted"));
+    assert_eq!(r.photons, 4 * o.photons);
+    let out = support::temp_folder("layout-interrupt-out");
+    r.write(out.path()).unwrap();
+    assert!(out.path().join("final/summary.json").is_file());
+}

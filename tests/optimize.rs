@@ -578,3 +578,52 @@ fn feedback_2d_beats_1d_on_phone_led() {
     let reloaded = dots_of(&again);
     assert_eq!(reloaded.density, two.final_density);
 }
+
+/// An interrupt during a search keeps the designs fully traced before it: the design
+/// being traced when it came is dropped (a part-traced design has fewer photons and is not
+/// comparable), the verification is not traced, and the result says it was interrupted.
+/// The interrupt is requested from the progress callback after the third iteration, so the
+/// stop point is deterministic.
+#[test]
+fn an_interrupted_search_keeps_the_designs_traced_before_it() {
+    let dir = small_scene("opt-interrupt", "density = [0.3]");
+    let scene = load(&dir);
+    for method in [Method::NelderMead, Method::Feedback] {
+        let opts = OptimizeOptions {
+            max_iter: 50,
+            ..small_options(method)
+        };
+        let stop = opts.interrupt.clone();
+        let mut reports = 0;
+        let r = optimize(&scene, &opts, &mut |it| {
+            reports += 1;
+            if it.iteration == 2 {
+                stop.request();
+            }
+        })
+        .unwrap();
+        assert!(r.interrupted, "{method}");
+        assert!(r.termination.contains("interrupted"), "{}", r.termination);
+        assert!(
+            r.verification.is_none(),
+            "{method}: verified after an interrupt"
+        );
+        assert_eq!(reports, r.history.len());
+        assert_eq!(r.history.last().unwrap().iteration, 2, "{method}");
+        // Every design kept was traced in full: the best is one of them.
+        assert_eq!(r.best.photons, opts.photons, "{method}");
+        assert_eq!(
+            r.photons % opts.photons,
+            0,
+            "{method}: a part-traced design counted"
+        );
+        let written = support::temp_folder("opt-interrupt-out");
+        let files = r.write(written.path()).unwrap();
+        assert!(files.iter().any(|f| f.ends_with("optimize.json")));
+        let json: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(written.path().join("optimize.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(json["interrupted"], true);
+    }
+}

@@ -145,6 +145,90 @@ fn sigterm_is_an_interrupt_too() {
     assert_eq!(summary(&out)["stopped_by"], "interrupted");
 }
 
+/// Start `blutrace args...` with its output piped; returns once a stdout line starts with
+/// `ready` (a search's first iteration line), with the child and the lines so far.
+fn spawn_until(args: &[&str], ready: &str) -> (Child, std::sync::mpsc::Receiver<String>) {
+    use std::io::BufRead;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start blutrace");
+    let stdout = child.stdout.take().unwrap();
+    let (send, lines) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stdout)
+            .lines()
+            .map_while(Result::ok)
+        {
+            if send.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let start = Instant::now();
+    loop {
+        match lines.recv_timeout(Duration::from_secs(300)) {
+            Ok(line) if line.starts_with(ready) => return (child, lines),
+            Ok(_) => {}
+            Err(e) => {
+                let _ = child.kill();
+                panic!(
+                    "no line starting with {ready:?} after {:?}: {e}",
+                    start.elapsed()
+                );
+            }
+        }
+    }
+}
+
+/// Ctrl-C during `optimize` ends the search after the design it is tracing, writes the
+/// whole output set of the designs traced before (optimize.json says `interrupted`) and
+/// exits 130. The verification's billion photons make sure the run is still going when the
+/// signal comes.
+#[test]
+fn ctrl_c_ends_an_optimization_with_its_best_design_so_far() {
+    let dir = support::temp_folder("ctrl-c-optimize");
+    let out = dir.path().join("out");
+    let (child, lines) = spawn_until(
+        &[
+            "optimize",
+            "scenes/bench-box",
+            "--photons",
+            "2e4",
+            "--verify-photons",
+            "1e9",
+            "--threads",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "iter",
+    );
+    signal(&child, "INT");
+    let run = wait_bounded(child, Duration::from_secs(120));
+    let stdout: Vec<String> = lines.iter().collect();
+    assert_eq!(run.status.code(), Some(130), "{stdout:?}");
+    assert!(
+        stdout
+            .iter()
+            .any(|l| l.starts_with("note       interrupted")),
+        "{stdout:?}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("optimize.json")).unwrap()).unwrap();
+    assert_eq!(json["interrupted"], true);
+    assert!(json["verification"].is_null());
+    for f in [
+        "optimized.toml",
+        "final/summary.json",
+        "initial/summary.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+}
+
 /// Photon counts are read as the README writes them; fractions and zero are refused.
 #[test]
 fn photon_counts_read_as_written() {

@@ -97,8 +97,8 @@ impl Command {
     fn execute(self) -> Result<ExitCode> {
         let done = match self {
             Command::Trace(args) => return trace::trace(args),
-            Command::Merge(args) => trace::merge(args),
-            Command::Optimize(args) => optimize::run(*args),
+            Command::Merge(args) => return trace::merge(args),
+            Command::Optimize(args) => return optimize::run(*args),
             Command::Bench {
                 photons,
                 threads,

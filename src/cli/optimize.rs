@@ -18,6 +18,7 @@ use crate::optimize::{
 use crate::scene::Scene;
 use anyhow::Result;
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 /// Arguments of `blutrace optimize`.
 #[derive(Debug, clap::Args)]
@@ -48,16 +49,41 @@ impl OptimizeArgs {
     }
 }
 
-/// Run `blutrace optimize`.
-pub fn run(args: OptimizeArgs) -> Result<()> {
+/// Run `blutrace optimize`: exit 130 after an interrupt (Ctrl-C), with the outputs of
+/// the designs traced before it when there are any.
+pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
+    let interrupt = super::stop_on_signals();
     let scene = Scene::load(&scene_path(&args.scene))?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let options = args.options(&scene);
-    if !options.vary.is_empty() {
-        return run_layout(&scene, &options, &args);
+    let options = OptimizeOptions {
+        interrupt,
+        ..args.options(&scene)
+    };
+    let done = if options.vary.is_empty() {
+        run_density(&scene, &options, &args)
+    } else {
+        run_layout(&scene, &options, &args)
+    };
+    match done {
+        Ok(false) => Ok(ExitCode::SUCCESS),
+        Ok(true) => {
+            println!(
+                "note       interrupted: the outputs hold the designs traced before it (the one being traced, and the verification, were dropped)"
+            );
+            Ok(ExitCode::from(130))
+        }
+        Err(e) if crate::run::is_interrupted(&e) => {
+            eprintln!("interrupted before the first design was traced: nothing written");
+            Ok(ExitCode::from(130))
+        }
+        Err(e) => Err(e),
     }
+}
+
+/// `blutrace optimize` of the dot density; returns whether an interrupt stopped it.
+fn run_density(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<bool> {
     let out = args.out.clone().unwrap_or_else(|| {
         let suffix = if options.tunes_grid() { "-2d" } else { "" };
         default_out(&format!(
@@ -80,7 +106,7 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
         options.seed
     );
     let quiet = args.quiet;
-    let result = optimize(&scene, &options, &mut |r| {
+    let result = optimize(scene, options, &mut |r| {
         if !quiet {
             println!("{r}");
         }
@@ -89,17 +115,18 @@ pub fn run(args: OptimizeArgs) -> Result<()> {
     for f in result.write(&out)? {
         println!("wrote      {}", f.display());
     }
-    Ok(())
+    Ok(result.interrupted)
 }
 
-/// `blutrace optimize --vary`.
-fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<()> {
+/// `blutrace optimize --vary`; returns whether an interrupt stopped it.
+fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<bool> {
     let out = args.out.clone().unwrap_or_else(|| {
         default_out(&format!(
             "{}-optimize-layout-{}",
             scene.name, options.method
         ))
     });
+    crate::output::atomic::check_dest(&out, crate::optimize::LAYOUT_OUTPUT_NAMES)?;
     println!(
         "optimize   {} ({}) by {} over {} variable(s): {} photons per design, seed {}, objective = {}",
         scene.name,
@@ -120,7 +147,7 @@ fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> 
     for f in result.write(&out)? {
         println!("wrote      {}", f.display());
     }
-    Ok(())
+    Ok(result.interrupted)
 }
 
 /// One line per evaluated design.

@@ -330,7 +330,11 @@ fn err(e: f64, digits: usize, sci: bool) -> String {
     }
 }
 
-pub(super) fn merge(args: MergeArgs) -> Result<()> {
+/// `blutrace merge`. An interrupt before the merged set is written ends it with nothing
+/// written (the inputs and any previous set untouched), exit 130; the set itself is
+/// written all-or-nothing.
+pub(super) fn merge(args: MergeArgs) -> Result<ExitCode> {
+    let interrupt = super::stop_on_signals();
     let shards = args
         .shards
         .iter()
@@ -361,7 +365,11 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
     check_apart(&args.out, &inputs)?;
     check_dest(&args.out, run::OUTPUT_NAMES)?;
     let result = shard::merge(&shards, &scene)?;
+    if interrupt.requested() {
+        eprintln!("interrupted before the merged outputs were written: nothing written");
+        return Ok(ExitCode::from(130));
+    }
     let files = result.write(&args.out)?;
     print_report(&result.summary(), &files);
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

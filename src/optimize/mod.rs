@@ -63,7 +63,7 @@ mod traced;
 mod verify;
 mod write;
 
-pub use layout::{LayoutResult, optimize_layout};
+pub use layout::{LayoutResult, OUTPUT_NAMES as LAYOUT_OUTPUT_NAMES, optimize_layout};
 pub use options::{Method, OptimizeOptions};
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};
@@ -71,6 +71,7 @@ pub use search::violation;
 pub use write::OUTPUT_NAMES;
 
 use crate::optics::dots::DotPattern;
+use crate::run::is_interrupted;
 use crate::scene::Scene;
 use anyhow::{Result, bail};
 use feedback_search::run_feedback;
@@ -92,10 +93,19 @@ pub fn optimize(
     let tag = scene.tags[search.tag_id].clone();
     let dots_placement = export_placement(search.pattern.placement, &tag, options)?;
     let initial_density = search.pattern.density.clone();
-    let termination = match options.method {
-        Method::NelderMead => run_nelder_mead(&mut search, progress)?,
-        Method::Feedback => run_feedback(&mut search, progress)?,
+    let searched = match options.method {
+        Method::NelderMead => run_nelder_mead(&mut search, progress),
+        Method::Feedback => run_feedback(&mut search, progress),
         Method::Grid => bail!("--method grid needs --vary"),
+    };
+    let mut interrupted = false;
+    let termination = match searched {
+        Ok(t) => t,
+        Err(e) if is_interrupted(&e) && search.best.is_some() => {
+            interrupted = true;
+            "interrupted (the design being traced is dropped)".to_string()
+        }
+        Err(e) => return Err(e),
     };
     let seconds = search.start.elapsed().as_secs_f64();
     let (Some((first_run, first_ev)), Some((best_run, best_ev, final_density))) =
@@ -117,11 +127,20 @@ pub fn optimize(
         None => None,
     };
     let sheet = export::SheetFrame::of_face(&pattern, &face, search.scene.offset);
-    let (initial_run, final_run, verification) =
-        match verify::verify(&search, &initial_density, &final_density)? {
-            Some((i, f, v)) => (i, f, Some(v)),
-            None => (first_run, best_run, None),
-        };
+    let verified = match interrupted {
+        true => None,
+        false => match verify::verify(&search, &initial_density, &final_density) {
+            Err(e) if is_interrupted(&e) => {
+                interrupted = true;
+                None
+            }
+            v => v?,
+        },
+    };
+    let (initial_run, final_run, verification) = match verified {
+        Some((i, f, v)) => (i, f, Some(v)),
+        None => (first_run, best_run, None),
+    };
     Ok(OptimizeResult {
         method: options.method,
         options: options.clone(),
@@ -135,6 +154,7 @@ pub fn optimize(
         history: std::mem::take(&mut search.history),
         seconds,
         termination,
+        interrupted,
         initial: first_ev,
         best: best_ev,
         verification,

@@ -57,6 +57,11 @@ pub struct OptimizeOptions {
     /// --seed`, whose default is the scene's `trace.seed`, sets it.
     #[arg(skip = 1u64)]
     pub seed: u64,
+    /// Stops the search after the design it is tracing: the result keeps the designs
+    /// traced before (set by the CLI's signal handler).
+    #[arg(skip)]
+    #[serde(skip)]
+    pub interrupt: crate::run::Interrupt,
     /// Iteration cap (Nelder-Mead steps, or feedback rounds after the first trace);
     /// default 60 for Nelder-Mead, 15 for feedback.
     #[arg(

@@ -61,6 +61,9 @@ pub struct OptimizeResult {
     pub seconds: f64,
     /// Why the search stopped.
     pub termination: String,
+    /// Stopped by an interrupt (Ctrl-C): the best design is the best of those fully
+    /// traced, and the verification was not traced (or not finished).
+    pub interrupted: bool,
     /// The first design at the search's seed and photons.
     pub initial: Evaluation,
     /// The final design at the search's seed and photons.

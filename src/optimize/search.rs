@@ -166,6 +166,7 @@ impl<'a> Search<'a> {
             threads: options.threads,
             backend: options.backend,
             estimator: options.estimator,
+            interrupt: options.interrupt.clone(),
             ..RunOptions::default()
         };
         Ok(Search {

@@ -3,7 +3,9 @@
 use super::objective::Evaluation;
 use super::search::dots_pattern;
 use crate::run::metrics::MetricValues;
-use crate::run::{self, ConvergenceRow, MeshBuildCache, RunOptions, RunResult, StoppedBy};
+use crate::run::{
+    self, ConvergenceRow, Interrupted, MeshBuildCache, RunOptions, RunResult, StoppedBy,
+};
 use crate::scene::Scene;
 use crate::tally::Tally;
 use anyhow::Result;
@@ -51,7 +53,8 @@ impl TracedRun {
     }
 
     /// Trace `scene` (reusing `builds` when the mesh is the last run's) and judge the
-    /// finished run with `judge`.
+    /// finished run with `judge`; an [`Interrupted`] error when the options' interrupt
+    /// stopped the trace before all its photons.
     pub(super) fn trace_judged<T>(
         scene: Scene,
         options: &RunOptions,
@@ -59,6 +62,9 @@ impl TracedRun {
         judge: impl FnOnce(&RunResult) -> T,
     ) -> Result<(TracedRun, T)> {
         let r = run::trace_reusing(&scene, options, builds, &|_| {})?;
+        if r.stopped_by == StoppedBy::Interrupted {
+            return Err(Interrupted.into());
+        }
         let judged = judge(&r);
         let RunResult {
             scene: _,

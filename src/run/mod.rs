@@ -216,6 +216,25 @@ impl Interrupt {
     }
 }
 
+/// The error of a search whose trace was interrupted ([`Interrupt::request`]) before its
+/// design was fully traced: a partly traced design has fewer photons than the others and
+/// is not compared with them, so callers stop and keep what was finished.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Interrupted;
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("interrupted")
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// Whether `e` is (or wraps) an [`Interrupted`].
+pub fn is_interrupted(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.is::<Interrupted>())
+}
+
 /// One row of the convergence history, taken after a round.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConvergenceRow {

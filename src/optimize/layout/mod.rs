@@ -31,10 +31,11 @@ pub use objective::{LayoutEvaluation, ObjectiveSpec};
 pub use result::{IntegerCase, LayoutResult, LayoutVerification, VariableResult, VerifiedLayout};
 pub use search::EvaluationRecord;
 pub use vary::{Variable, VarySpec};
+pub use write::OUTPUT_NAMES;
 
 use super::nelder_mead::{self, Settings};
 use super::{Method, OptimizeOptions};
-use crate::run::RunOptions;
+use crate::run::{RunOptions, is_interrupted};
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
 use search::{LayoutSearch, PENALTY};
@@ -73,6 +74,7 @@ pub fn optimize_layout(
             threads: options.threads,
             backend: options.backend,
             estimator: options.estimator,
+            interrupt: options.interrupt.clone(),
             ..RunOptions::default()
         },
         start: Instant::now(),
@@ -82,10 +84,11 @@ pub fn optimize_layout(
         seen: Default::default(),
         builds: Default::default(),
         reads: Default::default(),
+        interrupted: false,
     };
     let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
     search.evaluate(&initial_x, progress)?;
-    let Some((_, initial, _)) = search.best.clone() else {
+    let Some((initial_run, initial, _)) = search.best.clone() else {
         bail!("the scene's own design was not traced");
     };
     if search.vars.iter().any(|v| !v.contains(v.initial)) {
@@ -95,11 +98,14 @@ pub fn optimize_layout(
     let mut cases = Vec::new();
     for ints in integer_cases(&search.vars)? {
         cases.push(search_case(&mut search, &ints, progress)?);
+        if search.interrupted {
+            break;
+        }
     }
     let Some((_, best, best_x)) = search.best.clone() else {
         bail!("the search traced no design");
     };
-    result::finish(search, initial, best, best_x, cases)
+    result::finish(search, (initial_run, initial), best, best_x, cases)
 }
 
 /// The variables of `--vary`, resolved; continuous ones must start inside their range.
@@ -255,6 +261,38 @@ fn search_case(
         }
         Ok(value)
     };
+    let mut scan = |search: &mut LayoutSearch| -> Result<String> {
+        scan_case(search, &free, &scaled, &mut eval)
+    };
+    let termination = match scan(search) {
+        Ok(t) => t,
+        Err(e) if is_interrupted(&e) => {
+            search.interrupted = true;
+            "interrupted (the design being traced is dropped)".to_string()
+        }
+        Err(e) => return Err(e),
+    };
+    let (objective, noise, values) =
+        case_best.unwrap_or((f64::NAN, f64::NAN, full(search, &scaled)));
+
+    Ok(IntegerCase {
+        integers: ints.iter().flatten().copied().collect(),
+        values,
+        objective,
+        noise,
+        evaluations: search.history.len() - evaluations,
+        termination,
+    })
+}
+
+/// Scan or search one case's continuous variables `free` from `scaled` with `eval`;
+/// returns how it ended.
+fn scan_case(
+    search: &mut LayoutSearch,
+    free: &[usize],
+    scaled: &[f64],
+    eval: &mut dyn FnMut(&mut LayoutSearch, &[f64]) -> Result<f64>,
+) -> Result<String> {
     let termination = match (free.is_empty(), search.options.method) {
         (true, _) => {
             eval(search, &[])?;
@@ -272,7 +310,7 @@ fn search_case(
             // A start that does not load (the scene's pitch with more lamps than fit)
             // gives the simplex nothing to follow: start from the best design of a
             // coarse grid instead (one or two variables).
-            let mut start = scaled.clone();
+            let mut start = scaled.to_vec();
             let mut how = String::new();
             if eval(search, &start)? >= PENALTY && free.len() <= 2 {
                 let mut best: Option<(f64, Vec<f64>)> = None;
@@ -317,17 +355,7 @@ fn search_case(
             )
         }
     };
-    let (objective, noise, values) =
-        case_best.unwrap_or((f64::NAN, f64::NAN, full(search, &scaled)));
-
-    Ok(IntegerCase {
-        integers: ints.iter().flatten().copied().collect(),
-        values,
-        objective,
-        noise,
-        evaluations: search.history.len() - evaluations,
-        termination,
-    })
+    Ok(termination)
 }
 
 /// How far past a range's end (in the range's unit scale) a point still counts as on it:

@@ -4,8 +4,8 @@ use super::objective::LayoutEvaluation;
 use super::search::{EvaluationRecord, LayoutSearch};
 use crate::optimize::traced::TracedRun;
 use crate::optimize::{Method, OptimizeOptions};
-use crate::run::RunOptions;
 use crate::run::summary::Summary;
+use crate::run::{RunOptions, is_interrupted};
 use anyhow::Result;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -108,8 +108,12 @@ pub struct LayoutResult {
     pub initial: LayoutEvaluation,
     /// The best design at the search's seed and photons.
     pub best: LayoutEvaluation,
-    /// The re-traces with a fresh seed (None with `--verify-photons 0`).
+    /// The re-traces with a fresh seed (None with `--verify-photons 0` or after an
+    /// interrupt).
     pub verification: Option<LayoutVerification>,
+    /// Stopped by an interrupt (Ctrl-C): the best design is the best of those fully
+    /// traced.
+    pub interrupted: bool,
     /// The best design's scene file as a value tree (paths as in the original).
     #[serde(skip)]
     pub(super) final_doc: Value,
@@ -122,7 +126,7 @@ pub struct LayoutResult {
 /// Verify the scene's own design and the best one and gather the result.
 pub(super) fn finish(
     search: LayoutSearch,
-    initial: LayoutEvaluation,
+    (first_run, initial): (TracedRun, LayoutEvaluation),
     best: LayoutEvaluation,
     best_x: Vec<f64>,
     cases: Vec<IntegerCase>,
@@ -130,11 +134,10 @@ pub(super) fn finish(
     let seconds = search.start.elapsed().as_secs_f64();
     let options = search.options;
     let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
-    let (initial_run, final_run, verification) = if options.verify_photons == 0 {
-        let first = search.design(&initial_x)?;
-        let (initial_run, _) = search.trace(first, &search.run_options)?;
-        let best_run = search.best.as_ref().map(|b| b.0.clone());
-        (initial_run, best_run.expect("a best design"), None)
+    let best_run = || search.best.as_ref().map(|b| b.0.clone());
+    let mut interrupted = search.interrupted;
+    let verified = if options.verify_photons == 0 || interrupted {
+        None
     } else {
         let run_options = RunOptions {
             photons: options.verify_photons,
@@ -152,15 +155,27 @@ pub(super) fn finish(
                 },
             ))
         };
-        let (initial_run, i) = verify(&initial_x)?;
-        let (final_run, f) = verify(&best_x)?;
-        let v = LayoutVerification {
-            seed: run_options.seed,
-            photons: options.verify_photons,
-            initial: i,
-            final_design: f,
-        };
-        (initial_run, final_run, Some(v))
+        let both = verify(&initial_x).and_then(|i| Ok((i, verify(&best_x)?)));
+        match both {
+            Ok(((initial_run, i), (final_run, f))) => {
+                let v = LayoutVerification {
+                    seed: run_options.seed,
+                    photons: options.verify_photons,
+                    initial: i,
+                    final_design: f,
+                };
+                Some((initial_run, final_run, v))
+            }
+            Err(e) if is_interrupted(&e) => {
+                interrupted = true;
+                None
+            }
+            Err(e) => return Err(e),
+        }
+    };
+    let (initial_run, final_run, verification) = match verified {
+        Some((i, f, v)) => (i, f, Some(v)),
+        None => (first_run, best_run().expect("a best design"), None),
     };
     let variables = search
         .vars
@@ -189,6 +204,7 @@ pub(super) fn finish(
         initial,
         best,
         verification,
+        interrupted,
         initial_run,
         final_run,
     })

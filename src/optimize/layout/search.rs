@@ -71,6 +71,8 @@ pub(super) struct LayoutSearch<'a> {
     pub(super) builds: RefCell<MeshBuildCache>,
     /// The geometry files as read for the first design, copied for the others.
     pub(super) reads: ReadCache,
+    /// An interrupt stopped the search: the design it was tracing is dropped.
+    pub(super) interrupted: bool,
 }
 
 impl<'a> LayoutSearch<'a> {

@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The names a layout search writes into its folder.
-const OUTPUT_NAMES: &[&str] = &[
+/// The files and folders a layout search writes (and replaces) in its output folder.
+pub const OUTPUT_NAMES: &[&str] = &[
     "optimized.toml",
     "history.csv",
     "optimize.json",

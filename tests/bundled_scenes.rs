@@ -369,3 +369,33 @@ fn reflector_sheets_lie_just_below_the_light_guides() {
         "notebook14 and wedge-ccfl have reflector sheets"
     );
 }
+
+/// The picture a newcomer opens first shows the backlight, not the noise: at its default
+/// photons every bundled scene's map has a noise floor (`cv_noise_floor`, the cv noise
+/// alone would show) of at most 0.125. The floor falls as 1/sqrt(photons), so a trace of a
+/// sixteenth of them, with four times the floor, tells it in a fraction of the time. The
+/// test scenes (`scenes/test/`) are fixtures, not pictures.
+#[test]
+fn default_photons_resolve_the_map() {
+    for (name, _, scene) in load_all() {
+        if name.starts_with("test/") {
+            continue;
+        }
+        let options = blutrace::run::RunOptions {
+            photons: scene.default_photons / 16,
+            seed: scene.default_seed,
+            ..Default::default()
+        };
+        let run = blutrace::run::trace(&scene, &options, &|_| {}).unwrap();
+        let floor = run.summary().cv_noise_floor / 4.0;
+        println!(
+            "{name}: {} photons, noise floor {floor:.3}",
+            scene.default_photons
+        );
+        assert!(
+            floor <= 0.125,
+            "{name}: noise floor {floor:.3} at the default {} photons: raise [trace] photons",
+            scene.default_photons
+        );
+    }
+}

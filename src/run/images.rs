@@ -1,18 +1,25 @@
 //! The run's EXR images, laid out as image tools read them.
 //!
 //! - `flux.exr`: channel `Y` = irradiance on the target plane (W/mm^2 per bin), so that any
-//!   viewer shows a grey image; layer `stderr` (`stderr.Y`) = its standard error (W/mm^2);
-//!   layer `hits` (`hits.Y`, 32-bit unsigned integers) = photons scored per bin. Grid x
-//!   along the detector's `u`, y along `v`, y up in the image.
+//!   viewer shows a grey image (values ~1e-5: scale it, or use `preview.Y`); layer `stderr`
+//!   (`stderr.Y`) = its standard error (W/mm^2); layer `hits` (`hits.Y`) = photons scored
+//!   per bin; layer `preview` (`preview.Y`) = `Y / (2 * mean)`, display-referred: the mean
+//!   shows mid-grey, twice the mean white. Grid x along the detector's `u`, y along `v`, y
+//!   up in the image.
 //! - `angular.exr`: `Y` = radiant intensity (W/sr per (theta, phi) bin), `stderr.Y`,
 //!   `hits.Y`, and when the sources give lumens `luminance.Y` and `luminance_stderr.Y`
 //!   (cd/m^2, averaged over the target); x = phi, y = theta.
+//!
+//! `hits.Y` is a 32-bit float, exact up to 2^24 (16.7 million) photons in one bin: image
+//! tools normalise integer channels to [0, 1] on reading (OpenImageIO shows 6 hits of a
+//! `uint` channel as 1.4e-9), which a count must not be.
 //!
 //! Header attributes of both: `software` (`blutrace VERSION`) and `comments` (what the
 //! channels hold; the standard EXR attributes, which tools carry into other formats),
 //! `units` (of `Y` and `stderr.Y`), `scene`, `scene_hash` (the content hash of
 //! `scene::hash`, as in shard files), `seed` and `photons` (text: exact for every `u64`),
-//! `detector_origin_mm`, `detector_u`, `detector_v` (`[x, y, z]`), the bin and target sizes
+//! `detector_origin_mm` (in the scene file's frame, as written there), `detector_u`,
+//! `detector_v` (`[x, y, z]`), the bin and target sizes
 //! (`bin_size_x_mm`, `bin_size_y_mm`, `size_x_mm`, `size_y_mm`) or the angular bin sizes
 //! (`bin_theta_deg`, `bin_phi_deg`). All are EXR `string`s holding numbers in Rust's
 //! shortest round-trip form: exact, and read by every tool (OpenEXR's Python module's old
@@ -33,7 +40,8 @@ pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Re
         run,
         "W/mm^2",
         "blutrace flux map: Y = irradiance on the target plane (W/mm^2 per bin), \
-         stderr.Y = its standard error (W/mm^2), hits.Y = photons per bin; \
+         stderr.Y = its standard error (W/mm^2), hits.Y = photons per bin, \
+         preview.Y = Y / (2 * mean) for display; \
          x along detector_u, y along detector_v from detector_origin_mm",
     );
     for (name, v) in [
@@ -45,11 +53,13 @@ pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Re
         attrs.push((name, Attribute::Text(v.to_string())));
     }
     let (value, stderr, hits) = (f32s(&flux.value), f32s(&flux.stderr), counts(&flux.hits));
+    let preview = preview(&flux.value);
     staged.write_with("flux.exr", |path| {
         let channels = [
             ("Y", Samples::F32(&value)),
             ("stderr.Y", Samples::F32(&stderr)),
-            ("hits.Y", Samples::U32(&hits)),
+            ("hits.Y", Samples::F32(&hits)),
+            ("preview.Y", Samples::F32(&preview)),
         ];
         write_channels(path, flux.nx, flux.ny, &channels, &attrs)
     })?;
@@ -83,7 +93,7 @@ pub(super) fn write_angular_exr(run: &RunResult, staged: &SetDir) -> Result<()> 
     let mut channels = vec![
         ("Y", Samples::F32(&i)),
         ("stderr.Y", Samples::F32(&ie)),
-        ("hits.Y", Samples::U32(&hits)),
+        ("hits.Y", Samples::F32(&hits)),
     ];
     if lum.is_some() {
         channels.push(("luminance.Y", Samples::F32(&l)));
@@ -118,7 +128,7 @@ fn common_attributes(
         ),
         ("seed", text(run.options.seed.to_string())),
         ("photons", text(run.tally.ledger.photons.to_string())),
-        ("detector_origin_mm", vec3(d.origin)),
+        ("detector_origin_mm", vec3(d.origin + run.scene.offset)),
         ("detector_u", vec3(d.u)),
         ("detector_v", vec3(d.v)),
     ]
@@ -128,10 +138,14 @@ fn f32s(v: &[f64]) -> Vec<f32> {
     v.iter().map(|&x| x as f32).collect()
 }
 
-/// Hit counts as EXR `uint`; a bin beyond 2^32 - 1 photons (never met in practice: 4e9
-/// photons in one bin) saturates.
-fn counts(v: &[u64]) -> Vec<u32> {
-    v.iter()
-        .map(|&h| u32::try_from(h).unwrap_or(u32::MAX))
-        .collect()
+/// Hit counts as floats: exact to 2^24 per bin, rounded to 7 significant digits past it.
+fn counts(v: &[u64]) -> Vec<f32> {
+    v.iter().map(|&h| h as f32).collect()
+}
+
+/// `value / (2 * mean)`: the map for display, mean at mid-grey (zeros for an empty map).
+fn preview(value: &[f64]) -> Vec<f32> {
+    let mean = value.iter().sum::<f64>() / value.len().max(1) as f64;
+    let scale = if mean > 0.0 { 0.5 / mean } else { 0.0 };
+    value.iter().map(|&v| (v * scale) as f32).collect()
 }

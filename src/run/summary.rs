@@ -145,6 +145,12 @@ pub struct LedgerSummary {
 /// Detector facts for the summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct DetectorSummary {
+    /// The corner the bins count from (mm, in the scene file's frame, as written there).
+    pub origin_mm: [f64; 3],
+    /// The direction of the first bin index (unit vector).
+    pub u: [f64; 3],
+    /// The direction of the second bin index (unit vector).
+    pub v: [f64; 3],
     /// Size (mm).
     pub size_mm: [f64; 2],
     /// Flux bins.
@@ -260,6 +266,9 @@ impl RunResult<'_> {
                 }
             }),
             detector: DetectorSummary {
+                origin_mm: (d.origin + self.scene.offset).to_array(),
+                u: d.u.to_array(),
+                v: d.v.to_array(),
                 size_mm: d.size,
                 bins: d.bins,
                 bin_size_mm: d.bin_size(),

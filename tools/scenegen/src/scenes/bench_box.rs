@@ -12,6 +12,11 @@ use crate::templates::{
 };
 use crate::{GenFile, P3, Part, dim, triangle_count};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 2_000_000;
+
 /// Guide size (x along the light, y along the lit edge, z thickness) (mm); the guide spans
 /// 0..SIZE.
 pub const SIZE: P3 = [120.0, 80.0, 3.0];
@@ -137,7 +142,7 @@ Geometry: bench-box.obj (tags are its usemtl names), {triangles} triangles.
             lambert("reflector_sheet", SHEET_ALBEDO),
             strip.toml(),
             detector.toml(),
-            trace_table(400_000, 100_000),
+            trace_table(PHOTONS, 100_000),
         ],
     )
 }

@@ -26,6 +26,11 @@ use crate::templates::{
 };
 use crate::{GenFile, P3, Part, dim, num, triangle_count};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 1_500_000;
+
 /// Files below `scenes/` written by `tools/cad/export-reflector.sh`, not by scenegen.
 pub const EXPORTED: &[&str] = &[
     "cad-reflector/reflector.bin",
@@ -173,7 +178,7 @@ Geometry: lgp.obj ({triangles} triangles) and {file}.
             reflector_sheet(),
             Ccfl::new("lamp", c, LAMP_R, W).toml(),
             Detector::new([0.0, 0.0, T + DETECTOR_GAP], [L, W], [80, 60]).toml(),
-            trace_table(400_000, 100_000),
+            trace_table(PHOTONS, 100_000),
         ],
     )
 }

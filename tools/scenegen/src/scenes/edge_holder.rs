@@ -9,6 +9,11 @@ use crate::templates::{
 };
 use crate::{GenFile, P3, Part, arr, num};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 1_500_000;
+
 /// Guide size (x along the light, y along the lamp, z thickness) (mm).
 pub const SIZE: P3 = [100.0, 60.0, 3.0];
 /// CCFL radius (mm).
@@ -97,7 +102,7 @@ end_caps = true
             reflector_sheet(),
             Ccfl::new("lamp", lamp, LAMP_R, sy - 1.0).toml(),
             Detector::new([2.0, 0.0, sz + 0.5], [sx - 2.0, sy], [49, 30]).toml(),
-            trace_table(400_000, 100_000),
+            trace_table(PHOTONS, 100_000),
         ],
     )
 }

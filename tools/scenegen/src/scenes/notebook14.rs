@@ -9,6 +9,11 @@ use crate::templates::{
 };
 use crate::{GenFile, LampHolder, P3, Part, dim, triangle_count};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 6_000_000;
+
 /// Light guide length along x, lamp edge to lamp edge (mm).
 pub const L: f64 = 290.0;
 /// Light guide width along y, the lamps' direction (mm).
@@ -173,7 +178,7 @@ Geometry: notebook14.obj (tags are its usemtl names), {triangles} triangles.
         tables.push(lamp.toml());
     }
     tables.push(Detector::new([0.0, 0.0, T + DETECTOR_GAP], [L, W], [100, 100]).toml());
-    tables.push(trace_table(400_000, 100_000));
+    tables.push(trace_table(PHOTONS, 100_000));
     scene_file(&header, &tables)
 }
 

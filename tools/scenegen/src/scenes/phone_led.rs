@@ -14,6 +14,11 @@ use crate::templates::{
 };
 use crate::{GenFile, P3, Part, comment, dim, num, triangle_count};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 2_000_000;
+
 /// Light guide length along x, LED edge to far edge (mm).
 pub const L: f64 = 140.0;
 /// Light guide width along y, the LED row's direction (mm).
@@ -305,7 +310,7 @@ Geometry: phone-led.obj (tags are its usemtl names), {triangles} triangles.
         [(L - SHIELD_WIDTH) as usize, W as usize],
     );
     tables.push(detector.toml());
-    tables.push(trace_table(400_000, 100_000));
+    tables.push(trace_table(PHOTONS, 100_000));
     scene_file(&header, &tables)
 }
 

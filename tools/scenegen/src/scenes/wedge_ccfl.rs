@@ -8,6 +8,11 @@ use crate::templates::{
 };
 use crate::{GenFile, LampHolder, P3, Part, dim, dims, hexahedron, triangle_count, write_gltf};
 
+/// Default photons: the map's noise floor (`cv_noise_floor`, the cv of noise alone) about
+/// 0.1, so the first picture shows the backlight, not its noise (a few seconds on 2 cores;
+/// `tests/bundled_scenes.rs` checks it).
+const PHOTONS: u64 = 4_000_000;
+
 /// Light guide length along x, lamp edge to far edge (mm).
 pub const L: f64 = 200.0;
 /// Light guide width along y (mm).
@@ -187,7 +192,7 @@ are world coordinates in millimetres, z up.
             reflector_sheet(),
             Ccfl::new("lamp", lamp, LAMP_R, W).toml(),
             Detector::new([0.0, 0.0, T0 + DETECTOR_GAP], [L, W], [100, 100]).toml(),
-            trace_table(400_000, 100_000),
+            trace_table(PHOTONS, 100_000),
         ],
     )
 }

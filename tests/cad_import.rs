@@ -563,3 +563,171 @@ fn gltf_node_cycles_and_runaway_depth_are_errors() {
     );
     assert!(err.contains("deeper than 256"), "{err}");
 }
+
+/// A glTF primitive without a material is tagged by its mesh's name, else its node's,
+/// with a warning naming where it sits; with neither the error names node, mesh and
+/// primitive indices.
+#[test]
+fn gltf_primitives_without_materials_take_their_mesh_or_node_name() {
+    let (json, bin) = gltf(&part());
+    let no_material = json.replace(r#","material":0"#, "");
+    assert_ne!(no_material, json);
+    let scene_dir = |name: &str, json: &str| {
+        let path = write_scene(name, &scene_toml("file = \"part.gltf\""), &[]);
+        let dir = path.parent().unwrap().to_path_buf();
+        std::fs::write(dir.join("part.gltf"), json).unwrap();
+        std::fs::write(dir.join("part.bin"), &bin).unwrap();
+        path
+    };
+    let by_mesh = no_material.replace(r#""meshes":[{"#, r#""meshes":[{"name":"lgp","#);
+    let s = load(&scene_dir("gltf-mesh-name", &by_mesh));
+    assert_eq!(s.tags, ["lgp"]);
+    assert!(
+        s.warnings.iter().any(|w| w.contains(
+            "nodes[0] meshes[0] 'lgp' primitives[0]: no material name, tagged 'lgp' by its mesh's name"
+        )),
+        "{:?}",
+        s.warnings
+    );
+    let by_node = no_material.replace(
+        r#""nodes":[{"mesh":0}]"#,
+        r#""nodes":[{"mesh":0,"name":"lgp"}]"#,
+    );
+    let s = load(&scene_dir("gltf-node-name", &by_node));
+    assert_eq!(s.tags, ["lgp"]);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("by its node's name")),
+        "{:?}",
+        s.warnings
+    );
+    let err = format!(
+        "{:#}",
+        Scene::load(&scene_dir("gltf-no-name", &no_material)).expect_err("an untagged primitive")
+    );
+    assert!(
+        err.contains("part.gltf") && err.contains("nodes[0] meshes[0] primitives[0]"),
+        "{err}"
+    );
+    // The scene's tag needs no name from the file.
+    let path = write_scene(
+        "gltf-no-name-tagged",
+        &scene_toml("file = \"part.gltf\"\ntag = \"lgp\""),
+        &[],
+    );
+    let dir = path.parent().unwrap();
+    std::fs::write(dir.join("part.gltf"), &no_material).unwrap();
+    std::fs::write(dir.join("part.bin"), &bin).unwrap();
+    let s = load(&path);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+/// A part whose size is the scene's (here: the detector's, 125 x 62.5 mm) times 1/25.4 or
+/// 1/1000 was exported in other units than it is read in: a warning suggests the units.
+/// Read right, or as a small part of another shape, it gives none.
+#[test]
+fn parts_off_by_a_unit_factor_are_warned() {
+    let inches: Vec<[[f64; 3]; 3]> = part()
+        .iter()
+        .map(|t| t.map(|p| p.map(|c| c / 25.4)))
+        .collect();
+    let unit_warnings = |s: &Scene| -> Vec<String> {
+        s.warnings
+            .iter()
+            .filter(|w| w.contains("units = "))
+            .cloned()
+            .collect()
+    };
+    // The part sits in the lamp's reach only at full size: move the lamp with it.
+    let stl = stl_ascii(&inches);
+    let s = load_units(
+        "units-in",
+        "part.stl",
+        stl.as_bytes(),
+        "tag = \"lgp\"",
+        1.0 / 25.4,
+    );
+    let w = unit_warnings(&s);
+    assert!(
+        w.len() == 1 && w[0].contains("1/25.4") && w[0].contains("units = \"in\"?"),
+        "{w:?}"
+    );
+    // Declared in inches, it is right: no warning.
+    let s = load_one(
+        "units-in-ok",
+        "part.stl",
+        stl.as_bytes(),
+        "tag = \"lgp\"\nunits = \"in\"",
+    );
+    assert!(unit_warnings(&s).is_empty(), "{:?}", s.warnings);
+    // A glTF (metres) declared in millimetres: 1000x small.
+    let (json, bin) = gltf(&part());
+    let path = write_scene(
+        "units-m",
+        &scene_toml_lamp("file = \"part.gltf\"\nunits = \"mm\"\nup = \"y\"", 1e-3),
+        &[],
+    );
+    let dir = path.parent().unwrap();
+    std::fs::write(dir.join("part.gltf"), &json).unwrap();
+    std::fs::write(dir.join("part.bin"), &bin).unwrap();
+    let s = load(&path);
+    let w = unit_warnings(&s);
+    assert!(
+        w.len() == 1 && w[0].contains("1/1000") && w[0].contains("units = \"m\"?"),
+        "{w:?}"
+    );
+    // The part at its true size gives none.
+    let s = load_one("units-mm", "part.obj", obj(&part()).as_bytes(), "");
+    assert!(unit_warnings(&s).is_empty(), "{:?}", s.warnings);
+}
+
+/// scene_toml with the LED's centre scaled by `k` about the origin (so it stays on the
+/// part's edge when the part is read at the wrong scale).
+fn scene_toml_lamp(geometry: &str, k: f64) -> String {
+    scene_toml(geometry)
+        .replace(
+            "center = [-0.01, 31.25, 1.953125]",
+            &format!(
+                "center = [{:?}, {:?}, {:?}]\nwidth_mm = {:?}\nheight_mm = {:?}",
+                -0.01 * k,
+                31.25 * k,
+                1.953125 * k,
+                60.0 * k,
+                3.0 * k
+            ),
+        )
+        .replace("width_mm = 60.0\nheight_mm = 3.0\n", "")
+}
+
+/// load_one with the lamp scaled by `k` (scene_toml_lamp).
+fn load_units(name: &str, file: &str, bytes: &[u8], extra: &str, k: f64) -> Scene {
+    let geometry = format!("file = \"{file}\"\n{extra}");
+    let path = write_scene(name, &scene_toml_lamp(&geometry, k), &[]);
+    std::fs::write(path.parent().unwrap().join(file), bytes).unwrap();
+    load(&path)
+}
+
+/// Every tag without a surface table is reported in one error, with the files using it.
+#[test]
+fn every_missing_surface_table_is_reported_at_once() {
+    let tris = part();
+    let mut text = String::from("mtllib none.mtl\n");
+    for t in &tris {
+        for p in t {
+            text += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+    }
+    for (k, tag) in ["lgp", "back", "edge"].iter().enumerate() {
+        text += &format!("usemtl {tag}\n");
+        for f in (4 * k..4 * k + 4).filter(|f| *f < tris.len()) {
+            text += &format!("f {} {} {}\n", 3 * f + 1, 3 * f + 2, 3 * f + 3);
+        }
+    }
+    let err = load_err("missing-tables", "part.obj", text.as_bytes(), "");
+    assert!(
+        err.contains("[surfaces.back]")
+            && err.contains("[surfaces.edge]")
+            && err.contains("part.obj"),
+        "{err}"
+    );
+    assert!(!err.contains("[surfaces.lgp]"), "{err}");
+}

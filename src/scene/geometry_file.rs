@@ -234,6 +234,7 @@ impl GeometrySpec {
         if placement.mirrors {
             tris.triangles.iter_mut().for_each(|t| t.swap(1, 2));
         }
+        warnings.append(&mut tris.warnings);
         if let (Some(tag), Some(own)) = (&self.tag, &tris.own_tags) {
             warnings.push(format!(
                 "{}: tag = \"{tag}\" replaces the file's own material names ({})",

@@ -30,6 +30,11 @@ impl BoxMm {
         })
     }
 
+    /// The three sides (mm).
+    pub fn sides(&self) -> [f64; 3] {
+        std::array::from_fn(|i| self.max[i] - self.min[i])
+    }
+
     /// The largest side (mm).
     pub fn extent(&self) -> f64 {
         (0..3)
@@ -107,6 +112,86 @@ impl GeometryReport {
             )
         })
     }
+}
+
+/// Unit mistakes a file's size can give away: the factor its part is off by, and the
+/// `units` that would undo it. Inches read as millimetres make a part 25.4x small, metres
+/// (a glTF's own unit) declared `units = "mm"` 1000x small, and the reverse mistakes
+/// 25.4x or 1000x large.
+const UNIT_SLIPS: [(f64, &str, &str); 4] = [
+    (25.4, "1/25.4", "units = \"in\"?"),
+    (1000.0, "1/1000", "units = \"m\"?"),
+    (1.0 / 25.4, "25.4x", "units = \"mm\" (it reads as inches)?"),
+    (
+        1.0 / 1000.0,
+        "1000x",
+        "units = \"mm\" (it reads as metres)?",
+    ),
+];
+
+/// How close (as a ratio) a rescaled part's two largest sides must come to the
+/// reference's to count as the same size.
+const SAME_SIZE: f64 = 1.3;
+
+/// Warnings for geometry files (`reports[i]` with `is_file[i]`) whose part, scaled by a
+/// unit factor, takes the footprint of the rest of the scene (the other parts' bounding
+/// box) or of the detector (`detector_mm`, its two sides): about 25.4x or 1000x off, as a
+/// file exported in other units than read is. Both of the two largest sides must match
+/// within [`SAME_SIZE`], which a small part that is only proportioned like the scene (an
+/// LED package, a screw) does not.
+pub fn unit_slip_warnings(
+    reports: &[GeometryReport],
+    is_file: &[bool],
+    detector_mm: [f64; 2],
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for (i, r) in reports.iter().enumerate() {
+        let Some(own) = r.bounds_mm.filter(|_| is_file[i]) else {
+            continue;
+        };
+        let rest = reports
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| k != i)
+            .filter_map(|(_, o)| o.bounds_mm)
+            .reduce(|a, b| BoxMm {
+                min: std::array::from_fn(|k| a.min[k].min(b.min[k])),
+                max: std::array::from_fn(|k| a.max[k].max(b.max[k])),
+            });
+        let mut references = vec![("the detector", sides([detector_mm[0], detector_mm[1], 0.0]))];
+        if let Some(rest) = rest {
+            references.push(("the rest of the scene", sides(rest.sides())));
+        }
+        let part = sides(own.sides());
+        let slip = references.iter().find_map(|&(what, reference)| {
+            UNIT_SLIPS
+                .iter()
+                .find(|&&(k, _, _)| {
+                    same_size([part[0] * k, part[1] * k], reference) && !same_size(part, reference)
+                })
+                .map(|&(_, off, hint)| (what, reference, off, hint))
+        });
+        if let Some((what, reference, off, hint)) = slip {
+            out.push(format!(
+                "{}: the part is {:.4} x {:.4} mm, about {off} the size of {what} ({:.4} x {:.4} mm): {hint}",
+                r.file, part[0], part[1], reference[0], reference[1]
+            ));
+        }
+    }
+    out
+}
+
+/// The two largest of three sides, largest first.
+fn sides(mut s: [f64; 3]) -> [f64; 2] {
+    s.sort_by(|a, b| b.total_cmp(a));
+    [s[0], s[1]]
+}
+
+/// Whether both sides agree within [`SAME_SIZE`] (none of them zero).
+fn same_size(a: [f64; 2], b: [f64; 2]) -> bool {
+    a.iter()
+        .zip(&b)
+        .all(|(&x, &y)| x > 0.0 && y > 0.0 && (x / y).max(y / x) <= SAME_SIZE)
 }
 
 /// Warnings where the detector plane passes through a triangle inside its rectangle (the

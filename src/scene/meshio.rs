@@ -1,7 +1,8 @@
 //! Reading tagged triangles from OBJ, glTF 2.0, STL and PLY files.
 //!
 //! Tags: in OBJ the `usemtl` name (whether or not the `.mtl` file exists), else the
-//! `o`/`g` name; in glTF the material name of each primitive; STL and PLY carry none. A
+//! `o`/`g` name; in glTF the material name of each primitive (without one, with a warning,
+//! its mesh's name, else its node's); STL and PLY carry none. A
 //! scene's `tag` replaces them all. glTF node transforms are applied, then the placement
 //! the scene file gives ([`super::geometry_file`]).
 
@@ -26,6 +27,9 @@ pub struct TaggedTriangles {
     pub tags: Vec<String>,
     /// The file's own tags, where a scene's `tag` replaced them.
     pub own_tags: Option<Vec<String>>,
+    /// What the reader noticed that is legal but may not be meant (a glTF primitive
+    /// tagged by its mesh's name for want of a material).
+    pub warnings: Vec<String>,
 }
 
 impl TaggedTriangles {
@@ -124,12 +128,17 @@ pub fn load(
 ) -> Result<TaggedTriangles> {
     let mut tris = match format {
         Format::Obj => load_obj(path, transform, tag)?,
-        Format::Gltf => load_gltf(path, transform)?,
+        Format::Gltf => load_gltf(path, transform, tag.is_some())?,
         Format::Stl => load_stl(path, transform)?,
         Format::Ply => load_ply(path, transform)?,
     };
     if let Some(tag) = tag {
-        let mut own: Vec<String> = tris.tags.iter().filter(|t| *t != tag).cloned().collect();
+        let mut own: Vec<String> = tris
+            .tags
+            .iter()
+            .filter(|t| *t != tag && !t.is_empty())
+            .cloned()
+            .collect();
         own.sort_unstable();
         own.dedup();
         tris.own_tags = (!own.is_empty() && !format.untagged()).then_some(own);
@@ -191,7 +200,8 @@ fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTr
     Ok(out)
 }
 
-fn load_gltf(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
+/// Read a glTF file; `tagged`: the scene's `tag` replaces every primitive's own.
+fn load_gltf(path: &Path, transform: DMat4, tagged: bool) -> Result<TaggedTriangles> {
     let bytes = read_bytes(path, "geometry file")?;
     let gltf::Gltf {
         document: doc,
@@ -217,6 +227,7 @@ fn load_gltf(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
         visits: 0,
         buffers: &buffers,
         path,
+        tagged,
     };
     for node in scene.nodes() {
         walk.node(&node, transform, &mut out)?;
@@ -286,6 +297,8 @@ struct NodeWalk<'a> {
     visits: usize,
     buffers: &'a [gltf::buffer::Data],
     path: &'a Path,
+    /// The scene's `tag` replaces the primitives' own: none is needed.
+    tagged: bool,
 }
 
 impl NodeWalk<'_> {
@@ -311,7 +324,13 @@ impl NodeWalk<'_> {
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
-                add_primitive(&prim, &mesh, world, self.buffers, self.path, out)?;
+                let at = Primitive {
+                    node,
+                    mesh: &mesh,
+                    prim: &prim,
+                    tagged: self.tagged,
+                };
+                add_primitive(&at, world, self.buffers, self.path, out)?;
             }
         }
         self.ancestors.push(node.index());
@@ -323,44 +342,86 @@ impl NodeWalk<'_> {
     }
 }
 
+/// A primitive and where it sits in the file, for its tag and its messages.
+struct Primitive<'a> {
+    node: &'a gltf::Node<'a>,
+    mesh: &'a gltf::Mesh<'a>,
+    prim: &'a gltf::Primitive<'a>,
+    tagged: bool,
+}
+
+impl Primitive<'_> {
+    /// `nodes[2] meshes[0] 'lgp' primitives[1]`: what a message names.
+    fn place(&self) -> String {
+        let name = self
+            .mesh
+            .name()
+            .map_or(String::new(), |n| format!(" '{n}'"));
+        format!(
+            "nodes[{}] meshes[{}]{name} primitives[{}]",
+            self.node.index(),
+            self.mesh.index(),
+            self.prim.index()
+        )
+    }
+
+    /// The primitive's tag: its material's name, else (with a warning) its mesh's name,
+    /// else its node's; CAD exporters leave parts without a material.
+    fn tag(&self, path: &Path, warnings: &mut Vec<String>) -> Result<String> {
+        if let Some(name) = self.prim.material().name() {
+            return Ok(name.to_string());
+        }
+        if self.tagged {
+            // Replaced by the scene's tag; not one of the file's own tags.
+            return Ok(String::new());
+        }
+        let fallback = [("mesh", self.mesh.name()), ("node", self.node.name())]
+            .into_iter()
+            .find_map(|(what, name)| name.filter(|n| !n.trim().is_empty()).map(|n| (what, n)));
+        let Some((what, name)) = fallback else {
+            bail!(
+                "{}: {}: the primitive has no material name and neither its mesh nor its node a name, so no tag: name its material, or give the geometry entry a tag",
+                path.display(),
+                self.place()
+            );
+        };
+        warnings.push(format!(
+            "{}: {}: no material name, tagged '{name}' by its {what}'s name",
+            path.display(),
+            self.place()
+        ));
+        Ok(name.to_string())
+    }
+}
+
 fn add_primitive(
-    prim: &gltf::Primitive,
-    mesh: &gltf::Mesh,
+    at: &Primitive,
     world: DMat4,
     buffers: &[gltf::buffer::Data],
     path: &Path,
     out: &mut TaggedTriangles,
 ) -> Result<()> {
-    let mesh_name = mesh.name().unwrap_or("<unnamed>");
+    let prim = at.prim;
     if prim.mode() != gltf::mesh::Mode::Triangles {
         bail!(
-            "{}: mesh '{mesh_name}': primitive mode {:?} is not supported (triangles only)",
+            "{}: {}: primitive mode {:?} is not supported (triangles only)",
             path.display(),
+            at.place(),
             prim.mode()
         );
     }
-    let Some(tag) = prim.material().name() else {
-        bail!(
-            "{}: mesh '{mesh_name}': primitive has no material name, so no tag",
-            path.display()
-        );
-    };
+    let tag = at.tag(path, &mut out.warnings)?;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
     let positions: Vec<DVec3> = reader
         .read_positions()
-        .with_context(|| {
-            format!(
-                "{}: mesh '{mesh_name}': no POSITION attribute",
-                path.display()
-            )
-        })?
+        .with_context(|| format!("{}: {}: no POSITION attribute", path.display(), at.place()))?
         .map(|p| world.transform_point3(DVec3::new(p[0].into(), p[1].into(), p[2].into())))
         .collect();
     let indices: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
     };
-    out.push_indexed(&positions, &indices, tag, path)
+    out.push_indexed(&positions, &indices, &tag, path)
 }
 
 fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {

@@ -341,6 +341,7 @@ fn load_geometry(
     let mut tags: Vec<String> = Vec::new();
     let mut mesh = Mesh::default();
     let mut reports = Vec::new();
+    let mut missing = MissingSurfaces::new();
     for (i, g) in file.geometry.iter().enumerate() {
         let gpath = dir.join(&g.file);
         if !gpath.exists() {
@@ -375,8 +376,12 @@ fn load_geometry(
             name: g.file.display().to_string(),
         };
         reports.push(add_part(
-            ctx, file, &mut mesh, &mut tags, &part, &tris, warnings,
-        )?);
+            file,
+            (&mut mesh, &mut tags, &mut missing),
+            &part,
+            &tris,
+            warnings,
+        ));
     }
     for (i, p) in file.procedural.iter().enumerate() {
         let tris = p.build(ctx, i, lamps)?;
@@ -386,10 +391,40 @@ fn load_geometry(
             name,
         };
         reports.push(add_part(
-            ctx, file, &mut mesh, &mut tags, &part, &tris, warnings,
-        )?);
+            file,
+            (&mut mesh, &mut tags, &mut missing),
+            &part,
+            &tris,
+            warnings,
+        ));
     }
+    if !missing.is_empty() {
+        return Err(ctx.err("surfaces", missing_surfaces(&missing)));
+    }
+    let is_file: Vec<bool> = (0..reports.len())
+        .map(|i| i < file.geometry.len())
+        .collect();
+    warnings.extend(geometry_report::unit_slip_warnings(
+        &reports,
+        &is_file,
+        file.detector.size_mm,
+    ));
     Ok((mesh, tags, reports))
+}
+
+/// Every tag the geometry uses without a `[surfaces.TAG]` table, with the parts using it.
+type MissingSurfaces = std::collections::BTreeMap<String, Vec<String>>;
+
+/// The message listing every missing surface table at once.
+fn missing_surfaces(missing: &MissingSurfaces) -> String {
+    let list: Vec<String> = missing
+        .iter()
+        .map(|(tag, parts)| format!("[surfaces.{tag}] (tag '{tag}' of {})", parts.join(", ")))
+        .collect();
+    format!(
+        "the scene has no {}: add a table for each tag the geometry uses",
+        list.join(", no ")
+    )
 }
 
 /// A part's names: in messages (`label`) and in its report (`name`).
@@ -399,29 +434,26 @@ struct Part {
 }
 
 /// Add a part's triangles to `mesh` (their tags to `tags`), dropping zero-area ones with
-/// a warning; returns the part's report.
+/// a warning and noting in `missing` the tags without a surface table; returns the part's
+/// report.
 fn add_part(
-    ctx: &Ctx,
     file: &SceneFile,
-    mesh: &mut Mesh,
-    tags: &mut Vec<String>,
+    (mesh, tags, missing): (&mut Mesh, &mut Vec<String>, &mut MissingSurfaces),
     part: &Part,
     tris: &meshio::TaggedTriangles,
     warnings: &mut Vec<String>,
-) -> Result<GeometryReport> {
+) -> GeometryReport {
     let base = mesh.positions.len() as u32;
     let first = mesh.triangles.len();
     mesh.positions.extend(&tris.positions);
     let mut dropped = 0;
     for (t, tag) in tris.triangles.iter().zip(&tris.tags) {
         if !file.surfaces.contains_key(tag) {
-            return Err(ctx.err(
-                "surfaces",
-                format!(
-                    "{} uses tag '{tag}', but the scene has no [surfaces.{tag}]",
-                    part.label
-                ),
-            ));
+            let parts = missing.entry(tag.clone()).or_default();
+            if !parts.contains(&part.label) {
+                parts.push(part.label.clone());
+            }
+            continue;
         }
         let tri = t.map(|v| v + base);
         let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
@@ -450,7 +482,7 @@ fn add_part(
         .collect();
     let report = GeometryReport::new(part.name.clone(), mesh, &kept);
     warnings.extend(report.extent_warning());
-    Ok(report)
+    report
 }
 
 /// Check a surface entry and build its model (each model checks its own fields).

@@ -348,12 +348,7 @@ impl Builder {
     fn new(tag: &str) -> Self {
         Builder {
             tag: tag.to_string(),
-            out: TaggedTriangles {
-                positions: Vec::new(),
-                triangles: Vec::new(),
-                tags: Vec::new(),
-                own_tags: None,
-            },
+            out: TaggedTriangles::default(),
         }
     }
 

@@ -409,3 +409,26 @@ fn help_states_the_defaults_that_apply() {
     );
     assert!(!line.contains("[default: 60]"), "{line}");
 }
+
+/// `--quiet` is a flag of every command, before or after the command's name (clap checks
+/// the flags before it acts on `--help`, so an unknown one would fail here).
+#[test]
+fn every_command_takes_the_common_flags() {
+    for command in ["trace", "merge", "optimize", "bench", "check"] {
+        for args in [
+            [command, "--quiet", "--help"],
+            ["--quiet", command, "--help"],
+        ] {
+            let run = blutrace(&args);
+            assert!(
+                run.status.success(),
+                "{args:?}: {}",
+                String::from_utf8_lossy(&run.stderr)
+            );
+            let help = String::from_utf8_lossy(&run.stdout);
+            assert!(help.contains("--quiet"), "{args:?}: {help}");
+        }
+    }
+    let run = blutrace(&["check", "scenes/test/slab", "--quiet"]);
+    assert!(run.status.success());
+}

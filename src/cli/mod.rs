@@ -18,6 +18,10 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(version, about)]
 struct Cli {
+    /// No progress output (progress bars, per-iteration lines); results, warnings and errors
+    /// still print. Taken by every command, before or after its name.
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -64,7 +68,8 @@ enum Command {
 /// Parse the command line, run it, and report an error on stderr.
 pub fn main() -> ExitCode {
     quiet_on_broken_pipe();
-    match Cli::parse().command.execute() {
+    let cli = Cli::parse();
+    match cli.command.execute(cli.quiet) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -94,11 +99,11 @@ fn quiet_on_broken_pipe() {
 }
 
 impl Command {
-    fn execute(self) -> Result<ExitCode> {
+    fn execute(self, quiet: bool) -> Result<ExitCode> {
         let done = match self {
-            Command::Trace(args) => return trace::trace(args),
+            Command::Trace(args) => return trace::trace(args, quiet),
             Command::Merge(args) => return trace::merge(args),
-            Command::Optimize(args) => return optimize::run(*args),
+            Command::Optimize(args) => return optimize::run(*args, quiet),
             Command::Bench {
                 photons,
                 threads,

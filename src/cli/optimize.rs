@@ -34,9 +34,6 @@ pub struct OptimizeArgs {
     /// How to optimize.
     #[command(flatten)]
     pub options: OptimizeOptions,
-    /// No per-iteration lines.
-    #[arg(long)]
-    pub quiet: bool,
 }
 
 impl OptimizeArgs {
@@ -51,7 +48,8 @@ impl OptimizeArgs {
 
 /// Run `blutrace optimize`: exit 130 after an interrupt (Ctrl-C), with the outputs of
 /// the designs traced before it when there are any.
-pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
+/// `quiet`: no per-iteration lines.
+pub fn run(args: OptimizeArgs, quiet: bool) -> Result<ExitCode> {
     let interrupt = super::stop_on_signals();
     let scene = Scene::load(&scene_path(&args.scene))?;
     for w in &scene.warnings {
@@ -62,9 +60,9 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         ..args.options(&scene)
     };
     let done = if options.vary.is_empty() {
-        run_density(&scene, &options, &args)
+        run_density(&scene, &options, &args.out, quiet)
     } else {
-        run_layout(&scene, &options, &args)
+        run_layout(&scene, &options, &args.out, quiet)
     };
     match done {
         Ok(false) => Ok(ExitCode::SUCCESS),
@@ -83,8 +81,13 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
 }
 
 /// `blutrace optimize` of the dot density; returns whether an interrupt stopped it.
-fn run_density(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<bool> {
-    let out = args.out.clone().unwrap_or_else(|| {
+fn run_density(
+    scene: &Scene,
+    options: &OptimizeOptions,
+    out: &Option<PathBuf>,
+    quiet: bool,
+) -> Result<bool> {
+    let out = out.clone().unwrap_or_else(|| {
         let suffix = if options.tunes_grid() { "-2d" } else { "" };
         default_out(&format!(
             "{}-optimize-{}{suffix}",
@@ -105,7 +108,6 @@ fn run_density(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) ->
         options.photons,
         options.seed
     );
-    let quiet = args.quiet;
     let result = optimize(scene, options, &mut |r| {
         if !quiet {
             println!("{r}");
@@ -119,8 +121,13 @@ fn run_density(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) ->
 }
 
 /// `blutrace optimize --vary`; returns whether an interrupt stopped it.
-fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> Result<bool> {
-    let out = args.out.clone().unwrap_or_else(|| {
+fn run_layout(
+    scene: &Scene,
+    options: &OptimizeOptions,
+    out: &Option<PathBuf>,
+    quiet: bool,
+) -> Result<bool> {
+    let out = out.clone().unwrap_or_else(|| {
         default_out(&format!(
             "{}-optimize-layout-{}",
             scene.name, options.method
@@ -137,7 +144,6 @@ fn run_layout(scene: &Scene, options: &OptimizeOptions, args: &OptimizeArgs) -> 
         options.seed,
         options.objective
     );
-    let quiet = args.quiet;
     let result = optimize_layout(scene, options, &mut |r, names| {
         if !quiet {
             print_evaluation(r, names);

@@ -53,9 +53,6 @@ pub(super) struct TraceArgs {
     /// Do not use the convex-solid fast path (every ray goes through the backend).
     #[arg(long)]
     no_convex: bool,
-    /// No progress bar.
-    #[arg(long)]
-    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -72,13 +69,10 @@ pub(super) struct MergeArgs {
     /// Scene file to use (default: the one recorded in the shards).
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Accepted as by every command (a merge shows no progress bar).
-    #[arg(long)]
-    #[allow(dead_code)]
-    quiet: bool,
 }
 
-pub(super) fn trace(args: TraceArgs) -> Result<ExitCode> {
+/// `blutrace trace`; `quiet`: no progress bar.
+pub(super) fn trace(args: TraceArgs, quiet: bool) -> Result<ExitCode> {
     // First, so an interrupt while the scene loads is one too.
     let interrupt = super::stop_on_signals();
     let scene = Scene::load(&scene_path(&args.scene))?;
@@ -116,7 +110,7 @@ pub(super) fn trace(args: TraceArgs) -> Result<ExitCode> {
         &options,
         last - first,
         open_ended && args.photons.is_none(),
-        args.quiet,
+        quiet,
     );
     let result = run::trace(&scene, &options, &|p| match p {
         Progress::Chunk(n) => bar.inc(n),

@@ -651,6 +651,24 @@ fn parts_off_by_a_unit_factor_are_warned() {
         w.len() == 1 && w[0].contains("1/25.4") && w[0].contains("units = \"in\"?"),
         "{w:?}"
     );
+    // `check`, as a user runs it, prints the warning.
+    let path = write_scene(
+        "units-in-check",
+        &scene_toml_lamp("file = \"part.stl\"\ntag = \"lgp\"", 1.0 / 25.4),
+        &[],
+    );
+    std::fs::write(path.parent().unwrap().join("part.stl"), &stl).unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .arg("check")
+        .arg(&*path)
+        .output()
+        .unwrap();
+    let printed =
+        String::from_utf8_lossy(&run.stdout).to_string() + &String::from_utf8_lossy(&run.stderr);
+    assert!(
+        run.status.success() && printed.contains("units = \"in\"?"),
+        "{printed}"
+    );
     // Declared in inches, it is right: no warning.
     let s = load_one(
         "units-in-ok",

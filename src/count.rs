@@ -10,6 +10,16 @@
 //! `u64::MAX`. Parsed exactly (the mantissa's digits and the exponent as integers), so
 //! `123456789012345678e0` is that integer, not the nearest f64.
 
+/// Parse a number option (`--target-cv 0.03`, `--max-time 60`): a finite number; `NaN`
+/// and `inf` are refused here, so no option downstream sees one.
+pub fn parse_finite(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("{text:?} is not a finite number")),
+        Err(_) => Err(format!("{text:?} is not a number")),
+    }
+}
+
 /// Parse a count (`0` allowed): digits with optional `_` separators, an optional
 /// fraction and an optional `e` exponent, whose value must be a whole number.
 pub fn parse_count(text: &str) -> Result<u64, String> {
@@ -48,6 +58,14 @@ pub fn parse_photons(text: &str) -> Result<u64, String> {
     match parse_count(text)? {
         0 => Err(format!("{text:?}: at least 1 photon")),
         n => Ok(n),
+    }
+}
+
+/// [`parse_count`], from 1 to 1000: rounds of a benchmark.
+pub fn parse_rounds(text: &str) -> Result<usize, String> {
+    match parse_count(text)? {
+        n @ 1..=1000 => Ok(n as usize),
+        n => Err(format!("{n} rounds: give 1 to 1000")),
     }
 }
 

@@ -166,7 +166,10 @@ impl SourceSpec {
             "led"
         };
         Ok(Source {
-            name: name.clone().unwrap_or_else(|| format!("{kind}{i}")),
+            name: match name {
+                Some(n) => ctx.name(&f("name"), n)?.to_owned(),
+                None => format!("{kind}{i}"),
+            },
             power_w: ctx.positive(&f("power_w"), *power_w)?,
             lumens: ctx.optional_positive(&f("lumens"), *lumens)?,
             emitter,

@@ -9,6 +9,14 @@ use anyhow::Result;
 /// Largest coordinate or length (mm) a scene may use: beyond it f64 resolves no better
 /// than 0.1 mm, a unit or export error either way.
 pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Longest name (bytes) of a scene or a lamp: a folder name may have 255 bytes, and the
+/// name is part of longer ones.
+pub const MAX_NAME_BYTES: usize = 100;
+
+/// Largest rotation angle (degrees): a thousand turns and more is a typing mistake.
+pub const MAX_ANGLE_DEG: f64 = 3.6e5;
+
 use glam::DVec3;
 use std::path::Path;
 
@@ -27,7 +35,7 @@ impl Ctx<'_> {
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be a finite number, got {x}")))
+            Err(self.err(field, format!("must be a finite number, got {}", short(x))))
         }
     }
 
@@ -36,7 +44,7 @@ impl Ctx<'_> {
         if self.finite(field, x)? > 0.0 {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be > 0, got {x}")))
+            Err(self.err(field, format!("must be > 0, got {}", short(x))))
         }
     }
 
@@ -45,7 +53,7 @@ impl Ctx<'_> {
         if self.finite(field, x)? >= 0.0 {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be >= 0, got {x}")))
+            Err(self.err(field, format!("must be >= 0, got {}", short(x))))
         }
     }
 
@@ -54,7 +62,7 @@ impl Ctx<'_> {
         if (0.0..=1.0).contains(&self.finite(field, x)?) {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be within [0, 1], got {x}")))
+            Err(self.err(field, format!("must be within [0, 1], got {}", short(x))))
         }
     }
 
@@ -66,12 +74,22 @@ impl Ctx<'_> {
     /// A point with finite coordinates within [`MAX_COORDINATE`] mm (`field[i]` names a
     /// bad one).
     pub fn point(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
+        self.bounded(field, p, MAX_COORDINATE, " mm")
+    }
+
+    /// Rotation angles (degrees) within [`MAX_ANGLE_DEG`].
+    pub fn angles_deg(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
+        self.bounded(field, p, MAX_ANGLE_DEG, " degrees")
+    }
+
+    /// Three finite numbers within `±max` (`unit` after the bound in the message).
+    fn bounded(&self, field: &str, p: [f64; 3], max: f64, unit: &str) -> Result<DVec3> {
         for (i, c) in p.iter().enumerate() {
             let f = format!("{field}[{i}]");
-            if self.finite(&f, *c)?.abs() > MAX_COORDINATE {
+            if self.finite(&f, *c)?.abs() > max {
                 return Err(self.err(
                     &f,
-                    format!("must be within ±{MAX_COORDINATE:e} mm, got {c}"),
+                    format!("must be within ±{max:e}{unit}, got {}", short(*c)),
                 ));
             }
         }
@@ -83,18 +101,70 @@ impl Ctx<'_> {
         if self.positive(field, x)? > MAX_COORDINATE {
             return Err(self.err(
                 field,
-                format!("must be at most {MAX_COORDINATE:e} mm, got {x}"),
+                format!("must be at most {MAX_COORDINATE:e} mm, got {}", short(x)),
             ));
         }
         Ok(x)
     }
 
+    /// A name shown in outputs (a scene's or a lamp's): 1 to [`MAX_NAME_BYTES`] bytes,
+    /// no control characters (a NUL cannot be written into an EXR attribute or a file
+    /// name), no path separator and not `.` or `..` (a scene's name names its default
+    /// output folder).
+    pub fn name<'n>(&self, field: &str, name: &'n str) -> Result<&'n str> {
+        let why = if name.is_empty() {
+            Some("must not be empty".to_string())
+        } else if name.len() > MAX_NAME_BYTES {
+            Some(format!(
+                "is {} bytes long; at most {MAX_NAME_BYTES} (it names files and folders)",
+                name.len()
+            ))
+        } else if let Some(c) = name.chars().find(|c| c.is_control()) {
+            Some(format!(
+                "holds the control character {:?}; names are printable text",
+                c
+            ))
+        } else if name.contains(['/', '\\']) || name == "." || name == ".." {
+            Some(format!(
+                "is {name:?}: a name is not a path (no '/' or '\\')"
+            ))
+        } else {
+            None
+        };
+        match why {
+            Some(w) => Err(self.err(field, w)),
+            None => Ok(name),
+        }
+    }
+
     /// A non-zero direction, normalized.
     pub fn direction(&self, field: &str, p: [f64; 3]) -> Result<DVec3> {
-        let v = self.point(field, p)?;
+        let v = self.bounded(field, p, MAX_COORDINATE, "")?;
         if v.length() < 1e-12 {
             return Err(self.err(field, "must be a non-zero direction"));
         }
         Ok(v.normalize())
+    }
+}
+
+/// A number for a message: at most 6 significant digits (`1e300`, `0.333333`, `125`), so a
+/// bound error never prints 301 digits.
+pub fn short(x: f64) -> String {
+    let plain = format!("{x}");
+    if plain.len() <= 12 {
+        return plain;
+    }
+    let sci = format!("{x:.5e}");
+    match sci.split_once('e') {
+        Some((m, e)) => {
+            let m = m.trim_end_matches('0').trim_end_matches('.');
+            let e: i32 = e.parse().unwrap_or(0);
+            if (-4..=6).contains(&e) {
+                format!("{}", m.parse::<f64>().unwrap_or(x) * 10f64.powi(e))
+            } else {
+                format!("{m}e{e}")
+            }
+        }
+        None => plain,
     }
 }

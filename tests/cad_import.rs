@@ -296,7 +296,7 @@ type BadCase<'a> = (&'a str, &'a str, Vec<u8>, &'a str, &'a [&'a str]);
 fn bad_cad_input_names_the_file_and_field() {
     let tris = part();
     let text = obj(&tris);
-    let cases: [BadCase; 8] = [
+    let cases: [BadCase; 10] = [
         (
             "unit",
             "part.obj",
@@ -347,6 +347,20 @@ fn bad_cad_input_names_the_file_and_field() {
             &["part.stl", "header says 12 triangles"],
         ),
         (
+            "plyneg",
+            "part.ply",
+            (ply_header("ascii", 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n").into_bytes(),
+            "tag = \"lgp\"",
+            &["part.ply", "face 0", "vertex index -1", "negative"],
+        ),
+        (
+            "turns",
+            "part.obj",
+            text.clone().into(),
+            "rotate_deg = [1e300, 0.0, 0.0]",
+            &["geometry[0].rotate_deg[0]", "degrees", "got 1e300"],
+        ),
+        (
             "plyjunk",
             "part.ply",
             b"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n".to_vec(),
@@ -362,6 +376,9 @@ fn bad_cad_input_names_the_file_and_field() {
         // Parse errors quote the offending line; the loader's errors name the field.
         let placed = e.contains("geometry[0]") || e.contains("unknown variant");
         assert!(e.contains("scene.toml") && placed, "{name}: {e}");
+        // Numbers in short form: never a 301-digit bound.
+        let longest = e.split(|c: char| !c.is_ascii_digit()).map(str::len).max();
+        assert!(longest < Some(20), "{name}: {e}");
     }
 }
 
@@ -394,45 +411,82 @@ fn tag_overrides_the_file_materials_with_a_warning() {
     );
 }
 
-/// Two boxes of two media, the second shifted by `dx` along x.
-fn two_solids(name: &str, dx: f64, outside: &str) -> Scene {
+/// Two boxes, `a` of PMMA and `b` (4 x 4 x 1 mm) of `inside` with `outside` in front of
+/// its faces, shifted by `dx` along x: loaded, or the error.
+fn two_solids(name: &str, dx: f64, inside: &str, outside: &str) -> Result<Scene, String> {
     let a = box_obj([0.0, 0.0, 0.0], [10.0, 10.0, 2.0], ["a"; 6]);
     let b = box_obj([dx, 2.0, 0.5], [dx + 4.0, 6.0, 1.5], ["b"; 6]);
     let toml = format!(
         "version = 1\n[[geometry]]\nfile = \"a.obj\"\n[[geometry]]\nfile = \"b.obj\"\n\
-         [media.pmma]\nn = 1.49\n[media.pc]\nn = 1.58\n\
+         [media.pmma]\nn = 1.49\n[media.pc]\nn = 1.58\n[media.glass]\nn = 1.52\n\
+         [media.black]\nn = 1.58\nabsorption_per_mm = 1e9\n\
+         [media.grey]\nn = 1.58\nabsorption_per_mm = 1e3\n\
          [surfaces.a]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
-         [surfaces.b]\nmodel = \"dielectric\"\ninside = \"pc\"\noutside = \"{outside}\"\n\
+         [surfaces.b]\nmodel = \"dielectric\"\ninside = \"{inside}\"\noutside = \"{outside}\"\n\
          [[sources]]\ntype = \"led\"\ncenter = [-0.5, 5.0, 1.0]\nnormal = [1.0, 0.0, 0.0]\n\
          u = [0.0, 1.0, 0.0]\nwidth_mm = 4.0\nheight_mm = 1.0\npower_w = 1.0\n\
          [detector]\norigin = [0.0, 0.0, 2.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
          size_mm = [10.0, 10.0]\n"
     );
     let dir = write_scene(name, &toml, &[("a.obj", &a), ("b.obj", &b)]);
-    load(&dir)
+    Scene::load(&dir).map_err(|e| format!("{e:#}"))
 }
 
+/// Where media meet, every point has one medium and every face names the medium in front
+/// of it: crossing solids, solids of one medium overlapping, a face naming its own medium
+/// outside, or one naming a medium that is not there, are errors naming the field.
 #[test]
-fn overlapping_solids_are_reported() {
-    let crossing = two_solids("cad-overlap", 8.0, "air");
+fn overlapping_solids_and_wrong_outside_media_are_errors() {
+    let err = |r: Result<Scene, String>| r.map(|_| ()).expect_err("loaded");
+    let crossing = err(two_solids("cad-overlap", 8.0, "pc", "air"));
     assert!(
-        crossing.warnings.iter().any(|w| w.contains("overlap")),
-        "{:?}",
-        crossing.warnings
+        crossing.contains("overlap: their surfaces cross"),
+        "{crossing}"
     );
     // Wholly inside, with the outer medium named outside: a legitimate nesting.
-    let nested = two_solids("cad-nested", 3.0, "pmma");
+    let nested = two_solids("cad-nested", 3.0, "pc", "pmma").unwrap();
     assert!(nested.warnings.is_empty(), "{:?}", nested.warnings);
-    // Wholly inside, but its faces say air outside: reported.
-    let wrong = two_solids("cad-nested-air", 3.0, "air");
+    // Wholly inside, but its faces say air outside.
+    let wrong = err(two_solids("cad-nested-air", 3.0, "pc", "air"));
     assert!(
-        wrong.warnings.iter().any(|w| w.contains("lies inside")),
-        "{:?}",
-        wrong.warnings
+        wrong.contains("surfaces.b.outside") && wrong.contains("have 'pmma' in front"),
+        "{wrong}"
     );
-    // Side by side, touching along x = 10: no overlap.
-    let apart = two_solids("cad-apart", 10.0, "air");
+    // Side by side, touching along x = 10: air on the touching face is a gap between parts
+    // in contact (its other faces are in air anyway); PMMA is wrong for those others.
+    let apart = two_solids("cad-apart", 10.0, "pc", "air").unwrap();
     assert!(apart.warnings.is_empty(), "{:?}", apart.warnings);
+    let pmma = err(two_solids("cad-apart-pmma", 10.0, "pc", "pmma"));
+    assert!(pmma.contains("have 'air' in front"), "{pmma}");
+    let glass = err(two_solids("cad-apart-glass", 12.0, "pc", "glass"));
+    assert!(
+        glass.contains("surfaces.b.outside")
+            && glass.contains("is 'glass'")
+            && glass.contains("no closed solid encloses 'glass'"),
+        "{glass}"
+    );
+    // A black backing (absorbing whatever enters within nanometres) needs no solid; a
+    // medium that lets light travel on does.
+    two_solids("cad-backing", 12.0, "pc", "black").unwrap();
+    let grey = err(two_solids("cad-grey", 12.0, "pc", "grey"));
+    assert!(grey.contains("no closed solid encloses 'grey'"), "{grey}");
+    // A face between a medium and itself.
+    let same = err(two_solids("cad-same", 12.0, "pc", "pc"));
+    assert!(
+        same.contains("surfaces.b.outside") && same.contains("the medium inside too"),
+        "{same}"
+    );
+    // Two PMMA guides overlapping: one medium, two shells.
+    let guides = err(two_solids("cad-two-guides", 8.0, "pmma", "air"));
+    assert!(
+        guides.contains("two closed solids of medium 'pmma' overlap"),
+        "{guides}"
+    );
+    let inner = err(two_solids("cad-guide-in-guide", 3.0, "pmma", "air"));
+    assert!(
+        inner.contains("two closed solids of medium 'pmma' overlap"),
+        "{inner}"
+    );
 }
 
 #[test]
@@ -562,6 +616,29 @@ fn gltf_node_cycles_and_runaway_depth_are_errors() {
         Scene::load(&path).expect_err("a 400-deep chain loaded")
     );
     assert!(err.contains("deeper than 256"), "{err}");
+}
+
+/// An accessor whose `count` is more than its buffer view holds is an error naming the
+/// accessor, not a mesh loaded in part.
+#[test]
+fn gltf_accessor_counts_past_their_buffer_view_are_errors() {
+    let tris = part();
+    let (json, bin) = gltf(&tris);
+    let declared = format!(r#""count":{}"#, 3 * tris.len());
+    assert!(json.contains(&declared));
+    let bad = json.replace(&declared, r#""count":99999999"#);
+    let path = write_scene("gltf-count", &scene_toml("file = \"part.gltf\""), &[]);
+    let dir = path.parent().unwrap().to_path_buf();
+    std::fs::write(dir.join("part.gltf"), bad).unwrap();
+    std::fs::write(dir.join("part.bin"), &bin).unwrap();
+    let err = format!(
+        "{:#}",
+        Scene::load(&path).expect_err("a short accessor loaded")
+    );
+    assert!(
+        err.contains("part.gltf") && err.contains("POSITION accessor") && err.contains("99999999"),
+        "{err}"
+    );
 }
 
 /// A glTF primitive without a material is tagged by its mesh's name, else its node's,

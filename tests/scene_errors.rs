@@ -374,3 +374,113 @@ fn led_package_depth_and_duplicate_names() {
     let msg = error_of("dup-names", &dup);
     assert_mentions(&msg, &["sources[1].name", "'lamp'", "sources[0]"]);
 }
+
+/// A pattern's span is bounded where it matters: beyond 1e12 mm (a typing mistake), past
+/// ten times the face's reach (the face would see only the first per cent of a graded
+/// density: at `length_mm = 1e20` every groove vanished), and at 2^27 groove cells (the
+/// load time). Each error names the field, quickly and with a short number.
+#[test]
+fn pattern_spans_are_bounded() {
+    let graded = GOOD.replace("density = [0.2]", "density = [0.1, 0.2]");
+    let grooves = graded.replace(
+        "model = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"square\"",
+        "model = \"grooves\"\ninside = \"pmma\"\nrelief = \"cut\"\napex_deg = 110.0",
+    );
+    assert_ne!(grooves, graded);
+    let grid = GOOD.replace(
+        "density = [0.2]",
+        "density_grid = { width_mm = 1e300, values = [[0.1, 0.2], [0.1, 0.3]] }",
+    );
+    let cases: [(&str, String, &[&str]); 6] = [
+        (
+            "dots-1e300",
+            graded.replacen("length_mm = 20.0", "length_mm = 1e300", 1),
+            &["surfaces.dots.length_mm", "at most 1e12 mm", "got 1e300"],
+        ),
+        (
+            "dots-far",
+            graded.replacen("length_mm = 20.0", "length_mm = 1000.0", 1),
+            &["surfaces.dots.length_mm", "10 times the face's reach"],
+        ),
+        (
+            "grid-1e300",
+            grid,
+            &["surfaces.dots.density_grid", "width_mm must be at most"],
+        ),
+        (
+            "grooves-1e20",
+            grooves.replacen("length_mm = 20.0", "length_mm = 1e20", 1),
+            &["surfaces.dots.length_mm", "at most 1e12 mm"],
+        ),
+        (
+            "grooves-1e12",
+            grooves.replacen("length_mm = 20.0", "length_mm = 1e12", 1),
+            &["surfaces.dots.length_mm", "cells of pitch_mm"],
+        ),
+        (
+            "grooves-far",
+            grooves.replacen("length_mm = 20.0", "length_mm = 1000.0", 1),
+            &["surfaces.dots.length_mm", "10 times the face's reach"],
+        ),
+    ];
+    for (name, toml, words) in cases {
+        let start = std::time::Instant::now();
+        let msg = load_plate(name, &toml).expect_err(name);
+        assert_mentions(&msg, words);
+        let longest = msg.split(|c: char| !c.is_ascii_digit()).map(str::len).max();
+        assert!(longest < Some(20), "{name}: {msg}");
+        // Not a timing assertion of speed: a guard against the 10-minute loads of before.
+        assert!(
+            start.elapsed().as_secs() < 60,
+            "{name} took {:?}",
+            start.elapsed()
+        );
+    }
+    // Within the bounds, graded dots and grooves load.
+    for toml in [&graded, &grooves] {
+        load_plate("spans-ok", toml).unwrap();
+    }
+}
+
+/// Names that end up in file names and EXR attributes are printable text of at most 100
+/// bytes, refused when the scene loads, not after tracing.
+#[test]
+fn names_are_printable_and_short() {
+    let long = "n".repeat(300);
+    let cases = [
+        (
+            "name-nul",
+            "name = \"a\\u0000b\"".to_string(),
+            "name",
+            "control character",
+        ),
+        (
+            "name-long",
+            format!("name = \"{long}\""),
+            "name",
+            "300 bytes",
+        ),
+        (
+            "name-path",
+            "name = \"a/b\"".to_string(),
+            "name",
+            "not a path",
+        ),
+        (
+            "name-empty",
+            "name = \"\"".to_string(),
+            "name",
+            "must not be empty",
+        ),
+    ];
+    for (case, line, field, says) in cases {
+        let toml = GOOD.replace("version = 1", &format!("version = 1\n{line}"));
+        let msg = error_of(case, &toml);
+        assert_mentions(&msg, &["scene.toml", &format!("{field}: "), says]);
+    }
+    let msg = error_of(
+        "source-name",
+        &GOOD.replace("power_w = 1.0", "power_w = 1.0\nname = \"lamp\\tleft\""),
+    );
+    assert_mentions(&msg, &["sources[0].name", "control character"]);
+}

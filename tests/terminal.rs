@@ -432,3 +432,94 @@ fn every_command_takes_the_common_flags() {
     let run = blutrace(&["check", "scenes/test/slab", "--quiet"]);
     assert!(run.status.success());
 }
+
+/// Bad option values get blutrace's own message before anything runs: a negative number
+/// is read as the option's value (not clap's advice to write `-- -5`), NaN is no number,
+/// a benchmark needs a round, a missing scene is named as given, and `--vary` refuses the
+/// run's own settings.
+#[test]
+fn bad_option_values_are_refused_with_our_own_message() {
+    let dir = support::temp_folder("bad-values");
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["trace", "scenes/test/slab", "--photons", "-5", "--out", o],
+            "\"-5\" is not a count",
+        ),
+        (
+            &[
+                "optimize",
+                "scenes/phone-led",
+                "--target-cv",
+                "NaN",
+                "--out",
+                o,
+            ],
+            "\"NaN\" is not a finite number",
+        ),
+        (
+            &["trace", "scenes/test/slab", "--max-time", "inf", "--out", o],
+            "\"inf\" is not a finite number",
+        ),
+        (&["bench", "--repeat", "0"], "0 rounds: give 1 to 1000"),
+        (
+            &["bench", "--scene", "x/missing", "--photons", "1000"],
+            "--scene x/missing: no scene file x/missing",
+        ),
+        (
+            &[
+                "optimize",
+                "scenes/phone-led",
+                "--vary",
+                "trace.photons=1..2",
+                "--out",
+                o,
+            ],
+            "the search sets itself",
+        ),
+    ];
+    for (args, says) in cases {
+        let run = blutrace(args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} was accepted");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("-- -"), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote outputs");
+    }
+}
+
+/// A reader that closes stdout early (`| head -1`) ends the printing, not the work: an
+/// optimization still writes its whole output set and says so on stderr.
+#[test]
+fn a_closed_stdout_does_not_cost_an_optimization_its_outputs() {
+    let dir = support::temp_folder("closed-stdout");
+    let out = dir.path().join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .args([
+            "optimize",
+            "scenes/bench-box",
+            "--method",
+            "feedback",
+            "--max-iter",
+            "2",
+            "--photons",
+            "2e4",
+            "--verify-photons",
+            "0",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start blutrace");
+    drop(child.stdout.take());
+    let run = wait_bounded(child, Duration::from_secs(300));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{:?}: {err}", run.status);
+    assert!(err.contains("stdout was closed"), "{err}");
+    assert!(out.join("optimize.json").is_file(), "{err}");
+    assert!(out.join("final/summary.json").is_file(), "{err}");
+}

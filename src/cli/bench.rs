@@ -1,7 +1,38 @@
 //! `blutrace bench`: photons/s per backend as Markdown tables (ratios measured in one run).
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use std::path::Path;
+
+/// Both scenes are there before anything is timed: errors name the option and the path
+/// given (the box scene's default is derived from `--scene`, so a wrong `--scene` is named
+/// as such).
+pub(super) fn check_scenes(scene: &Path, box_scene: &Path) -> Result<()> {
+    let file = super::scene_path(scene);
+    if !file.is_file() {
+        bail!(
+            "--scene {}: no scene file {}",
+            scene.display(),
+            file.display()
+        );
+    }
+    let boxed = super::scene_path(box_scene);
+    if !boxed.is_file() {
+        bail!(
+            "--box-scene {}: no scene file {} (by default the folder bench-box beside --scene's folder)",
+            box_scene.display(),
+            boxed.display()
+        );
+    }
+    Ok(())
+}
+
+/// Stop a benchmark whose stdout's reader has gone: its tables are all it makes.
+fn reader_still_there() -> Result<()> {
+    if super::stdout_closed() {
+        bail!("stdout was closed: the benchmark stopped (its tables are its only output)");
+    }
+    Ok(())
+}
 
 pub(super) fn bench(
     scene: &Path,
@@ -11,25 +42,29 @@ pub(super) fn bench(
     repeat: usize,
 ) -> Result<()> {
     let rows = crate::bench::reference_table(box_scene, photons, threads, repeat)?;
-    println!(
+    say!(
         "| {}, {photons} photons | photons/s | interactions/s | ratio to the reference |",
         box_scene.display()
     );
-    println!("|---|---:|---:|---:|");
+    say!("|---|---:|---:|---:|");
     for r in rows {
-        println!(
+        say!(
             "| {} | {:.0} | {:.0} | {:.3} |",
-            r.tracer, r.photons_per_s, r.interactions_per_s, r.ratio_to_reference
+            r.tracer,
+            r.photons_per_s,
+            r.interactions_per_s,
+            r.ratio_to_reference
         );
     }
-    println!();
-    println!(
+    say!();
+    reader_still_there()?;
+    say!(
         "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
     );
-    println!("|---|---:|---|---|---:|---:|---:|");
+    say!("|---|---:|---|---|---:|---:|---:|");
     let traced = crate::bench::trace_table(scene, photons, threads, repeat)?;
     for r in &traced {
-        println!(
+        say!(
             "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
             r.scene,
             r.triangles,
@@ -40,42 +75,49 @@ pub(super) fn bench(
             r.ratio_to_obvhs
         );
     }
-    println!();
+    say!();
+    reader_still_there()?;
     print_load(scene, &traced, repeat)?;
     let table = crate::bench::in_guide_table(scene, 1_000_000, repeat)?;
     let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
-    println!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
-    println!("|---|---:|---:|");
+    say!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
+    say!("|---|---:|---:|");
     for (name, q) in &table {
-        println!("| {name} | {q:.0} | {:.2} |", convex / q);
+        say!("| {name} | {q:.0} | {:.2} |", convex / q);
     }
-    println!();
+    say!();
+    reader_still_there()?;
     let large = crate::bench::large_mesh_table(scene, 1_000_000, repeat)?;
     if let Some(native) = large.native_packets {
-        println!(
+        say!(
             "Embree packet widths on this machine: {native} (RTC_DEVICE_PROPERTY_NATIVE_RAY*_SUPPORTED)"
         );
-        println!();
+        say!();
+        reader_still_there()?;
     }
-    println!(
+    say!(
         "| lamp-cavity nearest-hit queries, {}-triangle mesh (1 thread) | rays | queries/s | ratio to obvhs |",
         large.triangles
     );
-    println!("|---|---|---:|---:|");
+    say!("|---|---|---:|---:|");
     for r in &large.rows {
-        println!(
+        say!(
             "| {} | {} | {:.0} | {:.2} |",
-            r.method, r.rays, r.queries_per_s, r.ratio_to_obvhs
+            r.method,
+            r.rays,
+            r.queries_per_s,
+            r.ratio_to_obvhs
         );
     }
-    println!();
+    say!();
+    reader_still_there()?;
     let rows = crate::bench::error_table(scene, 4.0, threads)?;
-    println!(
+    say!(
         "| backend | estimator | photons in ~4 s | mean-flux error | per-bin error | FOM mean | FOM bins |"
     );
-    println!("|---|---|---:|---:|---:|---:|---:|");
+    say!("|---|---|---:|---:|---:|---:|---:|");
     for r in rows {
-        println!(
+        say!(
             "| {} | {} | {} | {:.2e} | {:.3} | {:.3e} | {:.3e} |",
             r.backend,
             super::word(&r.estimator),
@@ -104,12 +146,12 @@ fn print_load(scene: &Path, traced: &[crate::bench::BenchRow], repeat: usize) ->
         );
     };
     let path = if fastest.convex { "on" } else { "off" };
-    println!(
+    say!(
         "| loading with every check | triangles | OBJ (MB) | seconds | photons traced in that time ({}, convex path {path}) |",
         fastest.backend
     );
-    println!("|---|---:|---:|---:|---:|");
-    println!(
+    say!("|---|---:|---:|---:|---:|");
+    say!(
         "| {} | {} | {:.0} | {:.2} | {:.0} |",
         fastest.scene,
         load.triangles,
@@ -117,6 +159,7 @@ fn print_load(scene: &Path, traced: &[crate::bench::BenchRow], repeat: usize) ->
         load.seconds,
         load.seconds * fastest.photons_per_s
     );
-    println!();
+    say!();
+    reader_still_there()?;
     Ok(())
 }

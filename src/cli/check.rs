@@ -90,24 +90,24 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),
             "warnings": scene.warnings,
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        say!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    println!("scene      {} ({})", scene.name, path.display());
-    println!(
+    say!("scene      {} ({})", scene.name, path.display());
+    say!(
         "geometry   {} triangles, {} tags",
         scene.mesh.len(),
         scene.tags.len()
     );
     for g in &scene.geometry {
-        println!(
+        say!(
             "  file {:<25} {:>8} triangles{}",
             g.file,
             g.triangles,
             bounds(g.bounds_mm)
         );
         for (tag, t) in &g.tags {
-            println!(
+            say!(
                 "    tag {tag:<22} {:>8} triangles{}",
                 t.triangles,
                 bounds(Some(t.bounds_mm))
@@ -126,7 +126,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             }
             _ => String::new(),
         };
-        println!(
+        say!(
             "  tag {tag:<20} {:<11} {n} triangles{placement}",
             model.kind()
         );
@@ -137,7 +137,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             None if i == 0 => "ambient".to_string(),
             None => "backend (not a lone convex solid)".to_string(),
         };
-        println!(
+        say!(
             "medium     {:<20} n = {}, absorption {} /mm{}; {path}",
             m.name,
             m.n,
@@ -146,20 +146,21 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         );
     }
     let backend = crate::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
-    println!("backend    auto picks {}", backend.name());
+    say!("backend    auto picks {}", backend.name());
     for s in &scene.sources.list {
         let body = s
             .body
             .as_ref()
             .map_or("transparent (no body)".to_string(), |b| b.describe());
         let medium = &scene.media[s.medium as usize].name;
-        println!(
+        say!(
             "source     {:<20} {:.3} W in {medium}; body: {body}",
-            s.name, s.power_w
+            s.name,
+            s.power_w
         );
     }
     let d = &scene.detector;
-    println!(
+    say!(
         "detector   {} x {} mm, {} x {} bins, {} x {} angular bins; tallies {:.1} MiB (at most {} GiB)",
         d.size[0],
         d.size[1],
@@ -170,13 +171,15 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         tally_bytes as f64 / (1u64 << 20) as f64,
         crate::run::TALLY_BUDGET_BYTES >> 30
     );
-    println!(
+    say!(
         "trace      {} photons, seed {}, bounce cap {}",
-        scene.default_photons, scene.default_seed, scene.max_bounces
+        scene.default_photons,
+        scene.default_seed,
+        scene.max_bounces
     );
     for w in &scene.warnings {
-        println!("warning    {w}");
+        say!("warning    {w}");
     }
-    println!("ok");
+    say!("ok");
     Ok(())
 }

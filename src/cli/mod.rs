@@ -2,6 +2,18 @@
 //! `bench`, `optimize`), each a thin layer that parses options, calls the library and
 //! prints. `src/main.rs` only calls [`main`].
 
+/// `println!` for the command line's reports, which never stops the work: a reader that
+/// closes stdout early (`blutrace optimize ... | head`) ends the printing, while the
+/// command goes on and writes its outputs ([`stdout_closed`] tells it so).
+macro_rules! say {
+    () => {
+        $crate::cli::say_line(format_args!(""))
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::say_line(format_args!($($arg)*))
+    };
+}
+
 mod bench;
 mod check;
 mod enums;
@@ -10,9 +22,11 @@ mod trace;
 
 use crate::run::Interrupt;
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Monte Carlo photon tracer for LCD backlight units.
 #[derive(Parser)]
@@ -51,7 +65,7 @@ enum Command {
         #[arg(long)]
         box_scene: Option<PathBuf>,
         /// Rounds per timing (each round measures every configuration once; medians).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = crate::count::parse_rounds)]
         repeat: usize,
     },
     /// Validate a scene and print what it uses.
@@ -67,9 +81,15 @@ enum Command {
 
 /// Parse the command line, run it, and report an error on stderr.
 pub fn main() -> ExitCode {
-    quiet_on_broken_pipe();
-    let cli = Cli::parse();
+    let matches = command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli.command.execute(cli.quiet) {
+        Ok(code) if stdout_closed() => {
+            eprintln!(
+                "note: stdout was closed before the report ended; the output files are complete"
+            );
+            code
+        }
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -78,24 +98,38 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// A reader that closes our stdout early (`blutrace check SCENE | head`) ends the
-/// program quietly, as it does other Unix tools, instead of with a panic message: Rust
-/// ignores SIGPIPE, so `println!` panics on the broken pipe. Exit status 141 (128 +
-/// SIGPIPE) is what a shell reports for a writer killed that way.
-fn quiet_on_broken_pipe() {
-    let default = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let payload = info.payload();
-        let msg = payload
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| payload.downcast_ref::<&str>().copied())
-            .unwrap_or("");
-        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
-            std::process::exit(141);
-        }
-        default(info)
-    }));
+/// The command line's grammar: every option's value may start with `-`, so `--photons -5`
+/// reaches blutrace's own check of the value ("not a count") instead of clap's advice to
+/// write `-- -5`, which does not apply to an option's value.
+fn command() -> clap::Command {
+    fn negatives(c: clap::Command) -> clap::Command {
+        c.mut_args(|a| {
+            let takes = a.get_action().takes_values();
+            a.allow_negative_numbers(takes)
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
+/// Set once a line could not be written to stdout (its reader is gone).
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+
+/// Write one line of a report to stdout (see `say!`); a failed write marks stdout closed
+/// and later lines are dropped.
+pub(crate) fn say_line(args: std::fmt::Arguments) {
+    if stdout_closed() {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if writeln!(out, "{args}").and_then(|()| out.flush()).is_err() {
+        STDOUT_CLOSED.store(true, Ordering::Relaxed);
+    }
+}
+
+/// Whether stdout's reader has gone (a write failed).
+pub(crate) fn stdout_closed() -> bool {
+    STDOUT_CLOSED.load(Ordering::Relaxed)
 }
 
 impl Command {
@@ -113,6 +147,7 @@ impl Command {
             } => {
                 let box_scene = box_scene
                     .unwrap_or_else(|| scene.parent().unwrap_or(Path::new(".")).join("bench-box"));
+                bench::check_scenes(&scene, &box_scene)?;
                 bench::bench(&scene, &box_scene, photons, threads, repeat)
             }
             Command::Check { scene, json } => check::check(&scene_path(&scene), json),

@@ -67,7 +67,7 @@ pub fn run(args: OptimizeArgs, quiet: bool) -> Result<ExitCode> {
     match done {
         Ok(false) => Ok(ExitCode::SUCCESS),
         Ok(true) => {
-            println!(
+            say!(
                 "note       interrupted: the outputs hold the designs traced before it (the one being traced, and the verification, were dropped)"
             );
             Ok(ExitCode::from(130))
@@ -100,7 +100,7 @@ fn run_density(
     } else {
         "cv of the flux profile along the axis"
     };
-    println!(
+    say!(
         "optimize   {} ({}) by {}: {} photons per design, seed {}, objective = {objective}",
         scene.name,
         scene.path.display(),
@@ -110,12 +110,12 @@ fn run_density(
     );
     let result = optimize(scene, options, &mut |r| {
         if !quiet {
-            println!("{r}");
+            say!("{r}");
         }
     })?;
     print_report(&result);
     for f in result.write(&out)? {
-        println!("wrote      {}", f.display());
+        say!("wrote      {}", f.display());
     }
     Ok(result.interrupted)
 }
@@ -134,7 +134,7 @@ fn run_layout(
         ))
     });
     crate::output::atomic::check_dest(&out, crate::optimize::LAYOUT_OUTPUT_NAMES)?;
-    println!(
+    say!(
         "optimize   {} ({}) by {} over {} variable(s): {} photons per design, seed {}, objective = {}",
         scene.name,
         scene.path.display(),
@@ -151,7 +151,7 @@ fn run_layout(
     })?;
     print_layout_report(&result);
     for f in result.write(&out)? {
-        println!("wrote      {}", f.display());
+        say!("wrote      {}", f.display());
     }
     Ok(result.interrupted)
 }
@@ -166,15 +166,15 @@ fn print_evaluation(r: &EvaluationRecord, names: &[String]) {
         r.assignment(names)
     );
     match (&r.result, &r.rejected) {
-        (Some(e), _) => println!("{head}  {e}"),
-        (None, Some(why)) => println!("{head}  not traced: {why}"),
-        (None, None) => println!("{head}"),
+        (Some(e), _) => say!("{head}  {e}"),
+        (None, Some(why)) => say!("{head}  not traced: {why}"),
+        (None, None) => say!("{head}"),
     }
 }
 
 /// The search's totals, each integer case, the variables and the verification.
 pub fn print_layout_report(r: &LayoutResult) {
-    println!(
+    say!(
         "search     {} designs, {} photons ({:.2}M), {:.1} s",
         r.history.len(),
         r.photons,
@@ -183,15 +183,19 @@ pub fn print_layout_report(r: &LayoutResult) {
     );
     if r.cases.len() > 1 {
         for c in &r.cases {
-            println!(
+            say!(
                 "case       {:?}: objective {:.4} ± {:.4} ({} designs; {})",
-                c.integers, c.objective, c.noise, c.evaluations, c.termination
+                c.integers,
+                c.objective,
+                c.noise,
+                c.evaluations,
+                c.termination
             );
         }
     } else if let Some(c) = r.cases.first() {
-        println!("stopped    {}", c.termination);
+        say!("stopped    {}", c.termination);
     }
-    println!(
+    say!(
         "objective  {:.4} ± {:.4} -> {:.4} ± {:.4} (seed {}, {} photons; cv noise floor {:.4})",
         r.initial.objective,
         r.initial.noise,
@@ -202,30 +206,35 @@ pub fn print_layout_report(r: &LayoutResult) {
         r.best.noise_floor
     );
     if r.best.below_noise_floor() || r.initial.below_noise_floor() {
-        println!(
+        say!(
             "warning    a design's cv is below its noise floor at {} photons: the cv term compares noise, not designs; use more --photons",
             r.options.photons
         );
     }
     for v in &r.variables {
-        println!(
+        say!(
             "variable   {} = {} -> {:.4} (range {}..{})",
-            v.name, v.initial, v.final_value, v.min, v.max
+            v.name,
+            v.initial,
+            v.final_value,
+            v.min,
+            v.max
         );
         if let Some(end) = v.at_range_end() {
-            println!(
+            say!(
                 "warning    {} ends within 1 % of its range's {end} end: the best design may lie beyond it (widen the range?)",
                 v.name
             );
         }
     }
     if let Some(v) = &r.verification {
-        println!(
+        say!(
             "verify     re-traced with seed {} and {} photons:",
-            v.seed, v.photons
+            v.seed,
+            v.photons
         );
-        println!("  initial  {}", v.initial.evaluation);
-        println!("  final    {}", v.final_design.evaluation);
+        say!("  initial  {}", v.initial.evaluation);
+        say!("  final    {}", v.final_design.evaluation);
     }
 }
 
@@ -235,11 +244,13 @@ fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {
     let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
         .max(0.0)
         .sqrt();
-    println!(
+    say!(
         "{label:<10} area cv {:.4} ± {:.4} (noise floor {:.4}, debiased {debiased:.4}) over the map without {margin} mm at the ends",
-        ev.area_cv, ev.area_cv_noise, ev.area_noise_floor
+        ev.area_cv,
+        ev.area_cv_noise,
+        ev.area_noise_floor
     );
-    println!(
+    say!(
         "{label:<10} profile cv {:.4} ± {:.4}; map cv {:.4} ± {:.4} (noise floor {:.4}, debiased {:.4} ± {:.4}), 13-pt {:.3} ± {:.3}, 9-pt {:.3} ± {:.3}, efficiency {:.4} ± {:.4}",
         v.evaluation.objective,
         v.evaluation.noise,
@@ -259,7 +270,7 @@ fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {
 
 /// Print the search's totals and the verification.
 pub fn print_report(r: &OptimizeResult) {
-    println!(
+    say!(
         "search     {}: {} iterations, {} designs, {} photons ({:.2}M), {:.1} s",
         r.termination,
         r.iterations,
@@ -268,7 +279,7 @@ pub fn print_report(r: &OptimizeResult) {
         r.photons as f64 * 1e-6,
         r.seconds
     );
-    println!(
+    say!(
         "objective  {:.4} ± {:.4} -> {:.4} ± {:.4} (seed {}; noise floor {:.4}: the cv of noise alone at {} photons)",
         r.initial.objective,
         r.initial.noise,
@@ -281,40 +292,41 @@ pub fn print_report(r: &OptimizeResult) {
     match &r.final_density {
         crate::optics::dots::Density::Polynomial(c) => {
             let c: Vec<String> = c.iter().map(|v| format!("{v:.6}")).collect();
-            println!("density    polynomial [{}]", c.join(", "));
+            say!("density    polynomial [{}]", c.join(", "));
         }
         crate::optics::dots::Density::Table(k) => {
-            println!("density    table of {} knots", k.len());
+            say!("density    table of {} knots", k.len());
         }
         crate::optics::dots::Density::Grid(g) => {
             let (nx, ny) = g.shape();
-            println!("density    grid of {nx} x {ny} knots (along x across)");
+            say!("density    grid of {nx} x {ny} knots (along x across)");
         }
     }
     match (&r.dots, r.dots_placement) {
         (Some(dots), Some(p)) if p == r.pattern.placement => {
-            println!(
+            say!(
                 "dots       {} on {} ({} placement)",
                 dots.len(),
                 r.tag,
                 p.name()
             )
         }
-        (Some(dots), Some(p)) => println!(
+        (Some(dots), Some(p)) => say!(
             "dots       {} on {}: the traced placement \"virtual\" is not printable; the dot files hold a {} placement of the same density",
             dots.len(),
             r.tag,
             p.name()
         ),
-        _ => println!(
+        _ => say!(
             "dots       none written: surfaces.{} has placement \"virtual\", which is not printable; --export-placement stochastic (or jittered, lattice) writes a printable sheet of the same density",
             r.tag
         ),
     }
     if let Some(v) = &r.verification {
-        println!(
+        say!(
             "verify     re-traced with seed {} and {} photons:",
-            v.seed, v.photons
+            v.seed,
+            v.photons
         );
         let m = r.options.edge_margin_mm;
         print_verified("  initial", &v.initial, m);

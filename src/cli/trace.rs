@@ -23,13 +23,13 @@ pub(super) struct TraceArgs {
     #[arg(long, visible_alias = "max-photons", value_parser = crate::count::parse_photons)]
     photons: Option<u64>,
     /// Stop when the relative standard error of --target-metric is at or below this.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::count::parse_finite)]
     target_error: Option<f64>,
     /// The metric --target-error refers to.
     #[arg(long, value_enum, default_value = "mean")]
     target_metric: TargetMetric,
     /// Stop after about this many seconds of tracing.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::count::parse_finite)]
     max_time: Option<f64>,
     /// Analog roulette (the paper's) or absorption by weights.
     #[arg(long, value_enum, default_value = "analog")]
@@ -120,11 +120,14 @@ pub(super) fn trace(args: TraceArgs, quiet: bool) -> Result<ExitCode> {
     if let Some(sh) = args.shard {
         let (first, last) = options.photon_range();
         let file = shard::write_shard(&result, &out)?;
-        println!(
+        say!(
             "shard      {}/{}: photons {first}..{last} of {} in {:.2} s",
-            sh.index, sh.count, options.photons, result.runtime_s
+            sh.index,
+            sh.count,
+            options.photons,
+            result.runtime_s
         );
-        println!("wrote      {}", file.display());
+        say!("wrote      {}", file.display());
         return Ok(exit_code(result.stopped_by));
     }
     let files = result.write(&out)?;
@@ -146,17 +149,17 @@ fn exit_code(stopped_by: StoppedBy) -> ExitCode {
 fn print_stop_note(o: &RunOptions, r: &run::RunResult) {
     let target = o.target_error.map(|e| (e, word(&o.target_metric)));
     match (r.stopped_by, target) {
-        (StoppedBy::Interrupted, _) => println!(
+        (StoppedBy::Interrupted, _) => say!(
             "note       interrupted: the outputs hold the {} photons traced before it",
             r.tally.ledger.photons
         ),
-        (StoppedBy::Unreachable, Some((e, m))) => println!(
+        (StoppedBy::Unreachable, Some((e, m))) => say!(
             "note       target error {e} of {m} cannot be reached: nothing was detected in {} photons, so the metric and its error are 0/0",
             r.tally.ledger.photons
         ),
         (StoppedBy::Photons | StoppedBy::Time, Some((e, m))) => {
             let rel = r.summary().figure_of_merit.rel_error;
-            println!(
+            say!(
                 "note       target error {e} of {m} not reached: its relative error is {} after {} photons{}",
                 err(rel, 3, false),
                 r.tally.ledger.photons,
@@ -238,8 +241,8 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     let absorbed =
         l.absorbed_w.values().sum::<f64>() + l.absorbed_in_medium_w.values().sum::<f64>();
     let lamps = l.absorbed_by_source_w.values().sum::<f64>();
-    println!("scene      {} ({})", s.scene, s.scene_file);
-    println!(
+    say!("scene      {} ({})", s.scene, s.scene_file);
+    say!(
         "traced     {} photons, seed {}, backend {}, estimator {}, {} threads; stopped by {}",
         s.photons,
         s.seed,
@@ -248,11 +251,13 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         s.threads,
         word(&s.stopped_by)
     );
-    println!(
+    say!(
         "time       {:.2} s  ({:.0} photons/s, {:.0} interactions/s)",
-        s.runtime_s, s.photons_per_s, s.interactions_per_s
+        s.runtime_s,
+        s.photons_per_s,
+        s.interactions_per_s
     );
-    println!(
+    say!(
         "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + lamp bodies {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
         l.emitted_w,
         l.detected_w,
@@ -263,16 +268,17 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         l.roulette_w,
         l.balance_rel_error
     );
-    println!(
+    say!(
         "efficiency {:.4} ± {:.4} of the emitted power reaches the target",
-        s.extraction_efficiency, s.extraction_efficiency_stderr
+        s.extraction_efficiency,
+        s.extraction_efficiency_stderr
     );
-    println!(
+    say!(
         "flux       mean {:.4e} ± {} W/mm²",
         u.mean,
         err(e.mean, 1, true)
     );
-    println!(
+    say!(
         "uniformity cv {:.3} ± {} (noise floor {:.3}, debiased {:.3}), min/max {:.3} ± {}, 9-pt {:.3} ± {}, 13-pt {:.3} ± {}",
         u.cv,
         err(e.cv, 3, false),
@@ -287,30 +293,32 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     );
     let chunk = crate::tracer::CHUNK;
     if l.detected_w == 0.0 {
-        println!(
+        say!(
             "note       no photon reached the target: the map and its uniformity metrics are empty"
         );
     } else if s.photons < 2 * chunk {
-        println!(
+        say!(
             "note       errors of the map's metrics (jackknife over chunks of {chunk} photons) need at least {} photons; this run traced {}",
             2 * chunk,
             s.photons
         );
     }
-    println!(
+    say!(
         "noise      mean relative stderr per bin {:.3}; figure of merit 1/(err²·t) = {} ({})",
         s.mean_rel_stderr,
         err(s.figure_of_merit.per_s, 3, true),
         word(&s.figure_of_merit.metric)
     );
     if let Some(lum) = &s.luminance {
-        println!(
+        say!(
             "luminance  on-axis {:.1} ± {:.1} cd/m² (sources at {:.0} lm/W)",
-            lum.on_axis_cd_m2, lum.on_axis_stderr_cd_m2, lum.efficacy_lm_per_w
+            lum.on_axis_cd_m2,
+            lum.on_axis_stderr_cd_m2,
+            lum.efficacy_lm_per_w
         );
     }
     for f in files {
-        println!("wrote      {}", f.display());
+        say!("wrote      {}", f.display());
     }
 }
 

@@ -47,6 +47,54 @@ pub fn check_pitch(ctx: &Ctx, field: &str, pitch: f64, reach: f64) -> Result<()>
     Ok(())
 }
 
+/// A pattern's span (`length_mm` along its axis, a density grid's `width_mm` across it)
+/// is at most this many times the face's reach: a longer span puts the whole face within
+/// its first few per cent, where a graded density reads as a constant (at `length_mm =
+/// 1e20` every groove vanishes), so it is a unit or typing mistake.
+pub const SPAN_PER_REACH: f64 = 10.0;
+
+/// Most lattice cells along a groove pattern's span (`length_mm / pitch_mm`): its deepest
+/// groove is found cell by cell, so the span bounds the loading time (2^27 cells, a
+/// fraction of a second; a 300 mm guide at a 1 um pitch has 3e5).
+pub const MAX_SPAN_CELLS: f64 = (1u64 << 27) as f64;
+
+/// Check a pattern's span (mm, named by `field`) against the face's `reach` (mm), see
+/// [`SPAN_PER_REACH`].
+pub fn check_span(ctx: &Ctx, field: &str, span: f64, reach: f64) -> Result<()> {
+    let max = SPAN_PER_REACH * reach;
+    if span > max {
+        return Err(ctx.err(
+            field,
+            format!(
+                "{} mm is more than {SPAN_PER_REACH} times the face's reach ({} mm from the pattern's origin): the face would see only the first {:.2e} of the span",
+                crate::spec_check::short(span),
+                crate::spec_check::short(reach),
+                reach / span
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check that a groove pattern's span (`length_mm`, named by `field`) holds at most
+/// [`MAX_SPAN_CELLS`] cells of `pitch` (mm).
+pub fn check_cells(ctx: &Ctx, field: &str, span: f64, pitch: f64) -> Result<()> {
+    let cells = span / pitch;
+    if cells > MAX_SPAN_CELLS {
+        return Err(ctx.err(
+            field,
+            format!(
+                "{} mm holds {} cells of pitch_mm = {} mm, more than the {} a pattern may have",
+                crate::spec_check::short(span),
+                crate::spec_check::short(cells.floor()),
+                crate::spec_check::short(pitch),
+                MAX_SPAN_CELLS
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// How the polynomial's variable is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -237,7 +285,17 @@ impl Density {
                 }
                 // One row needs no span across; more rows need a positive one.
                 if !(g.width.is_finite() && (g.width > 0.0 || (ny == 1 && g.width == 0.0))) {
-                    return Some(format!("width_mm must be positive, got {}", g.width));
+                    return Some(format!(
+                        "width_mm must be positive, got {}",
+                        crate::spec_check::short(g.width)
+                    ));
+                }
+                if g.width > crate::spec_check::MAX_COORDINATE {
+                    return Some(format!(
+                        "width_mm must be at most {:e} mm, got {}",
+                        crate::spec_check::MAX_COORDINATE,
+                        crate::spec_check::short(g.width)
+                    ));
                 }
                 if !g.v_min.is_finite() {
                     return Some("v_min_mm is not a finite number".into());

@@ -148,7 +148,7 @@ impl DotsSpec {
                 Some(a) => ctx.direction(&f("across"), a)?,
                 None => DVec3::ZERO,
             },
-            length: ctx.positive(&f("length_mm"), self.length_mm)?,
+            length: ctx.length(&f("length_mm"), self.length_mm)?,
             density,
             x_unit: self.x_unit,
             mirror: self.mirror,
@@ -257,7 +257,7 @@ impl DotPattern {
     }
 
     /// The density graded along the span, as the range check sees it.
-    fn gradation(&self) -> Gradation {
+    pub fn gradation(&self) -> Gradation {
         Gradation {
             density: self.density.clone(),
             length: self.length,

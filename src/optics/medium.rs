@@ -54,7 +54,19 @@ pub struct Medium {
     pub particles: Option<ParticlesSpec>,
 }
 
+/// Absorption (1/mm) from which a clear medium is a black backing: whatever enters it is
+/// absorbed within 37 nm (the analog tracer's longest free path, -ln(2^-53) / mu), so it
+/// needs no closed solid of its own; see [`Medium::is_backing`].
+pub const BACKING_PER_MM: f64 = 1e6;
+
 impl Medium {
+    /// A medium that absorbs at once whatever enters it (at least [`BACKING_PER_MM`], no
+    /// scattering): a face may name it outside with no solid around it, as an
+    /// index-matched black coating of no thickness.
+    pub fn is_backing(&self) -> bool {
+        self.absorption_per_mm >= BACKING_PER_MM && self.scattering.per_mm == 0.0
+    }
+
     /// A medium that does not scatter.
     pub fn clear(name: &str, n: f64, absorption_per_mm: f64) -> Medium {
         Medium {
@@ -314,10 +326,19 @@ impl Interface {
         outside: &str,
         media: &[Medium],
     ) -> Result<Interface> {
-        Ok(Interface {
+        let face = Interface {
             inside: medium_id(ctx, &format!("surfaces.{tag}.inside"), inside, media)?,
             outside: medium_id(ctx, &format!("surfaces.{tag}.outside"), outside, media)?,
-        })
+        };
+        if face.inside == face.outside {
+            return Err(ctx.err(
+                &format!("surfaces.{tag}.outside"),
+                format!(
+                    "is '{outside}', the medium inside too: a face between a medium and itself is no interface (name the medium in front of the face)"
+                ),
+            ));
+        }
+        Ok(face)
     }
 }
 

@@ -72,33 +72,33 @@ pub struct OptimizeOptions {
     )]
     pub max_iter: usize,
     /// Stop once the objective (cv of the profile along the axis) is at or below this.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::count::parse_finite)]
     pub target_cv: Option<f64>,
     /// Degree of the density polynomial (default: the scene's, at least 3).
     #[arg(long)]
     pub degree: Option<usize>,
     /// Smallest printable density (area fraction).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = crate::count::parse_finite)]
     pub min_density: f64,
     /// Largest density (default and at most: the lattice's packing limit).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::count::parse_finite)]
     pub max_density: Option<f64>,
     /// The dots surface to optimize (default: the scene's only one).
     #[arg(long)]
     pub tag: Option<String>,
     /// Nelder-Mead: initial simplex step (density units at the far end; with --vary, a
     /// fraction of each variable's range).
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(long, default_value_t = 0.2, value_parser = crate::count::parse_finite)]
     pub initial_step: f64,
     /// Nelder-Mead: stop once the simplex is smaller than this (density units; with --vary,
     /// a fraction of each variable's range).
-    #[arg(long, default_value_t = 2e-3)]
+    #[arg(long, default_value_t = 2e-3, value_parser = crate::count::parse_finite)]
     pub simplex_tol: f64,
     /// Feedback: damping exponent of d <- d (target / measured)^alpha.
-    #[arg(long, default_value_t = 0.7)]
+    #[arg(long, default_value_t = 0.7, value_parser = crate::count::parse_finite)]
     pub alpha: f64,
     /// Feedback: weight of the neighbours' mean in a smoothing pass (0: none).
-    #[arg(long, default_value_t = 0.25)]
+    #[arg(long, default_value_t = 0.25, value_parser = crate::count::parse_finite)]
     pub smoothing: f64,
     /// Feedback: 1 (a table of knots along the axis) or 2 (a grid over the face, for
     /// non-uniformity across the axis too, such as LEDs on an edge).
@@ -112,7 +112,7 @@ pub struct OptimizeOptions {
     #[arg(long)]
     pub strips: Option<usize>,
     /// Leave this many mm at either end of the span out of the objective.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::count::parse_finite)]
     pub edge_margin_mm: f64,
     /// Photons of the verification re-traces of the first and final design (0: none; the
     /// optimization's own traces of the first and best design are reported instead).

@@ -229,7 +229,9 @@ pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
     let mut foreign: Vec<String> = Vec::new();
     for e in fs::read_dir(&real).with_context(|| format!("{shown}: cannot list"))? {
         let n = e?.file_name().to_string_lossy().into_owned();
-        if n != MANIFEST && !ours.contains(&n) && parse_temp(&n).is_none() {
+        // A name like a staging folder's is foreign too: staging folders live beside the
+        // output folder, never in it, so such an entry is someone's file.
+        if n != MANIFEST && !ours.contains(&n) {
             foreign.push(n);
         }
     }
@@ -362,8 +364,7 @@ fn recover(parent: &Path, name: &str, shown: &Path) {
 /// when the exchange is not supported) two renames; returns where the previous folder went
 /// (to be removed), if there was one.
 fn swap_into_place(staging: &Path, dest: &Path, two_step: bool) -> io::Result<Option<PathBuf>> {
-    if fs::symlink_metadata(dest).is_err() {
-        fs::rename(staging, dest)?;
+    if fs::symlink_metadata(dest).is_err() && rename_to_new(staging, dest)? {
         return Ok(None);
     }
     if !two_step && exchange(staging, dest)? {
@@ -382,6 +383,17 @@ fn swap_into_place(staging: &Path, dest: &Path, two_step: bool) -> io::Result<Op
         return Err(e);
     }
     Ok(Some(aside))
+}
+
+/// Rename `staging` to `dest`, which did not exist a moment ago; `Ok(false)` when another
+/// run has created `dest` since (two runs into one new folder): the caller then replaces
+/// that set like any previous one, so the last run's complete set is what remains.
+fn rename_to_new(staging: &Path, dest: &Path) -> io::Result<bool> {
+    match fs::rename(staging, dest) {
+        Ok(()) => Ok(true),
+        Err(_) if fs::symlink_metadata(dest).is_ok() => Ok(false),
+        Err(e) => Err(e),
+    }
 }
 
 /// Exchange the folders `a` and `b` atomically; `Ok(false)` when the file system or system

@@ -186,3 +186,39 @@ fn temporary_names_parse() {
     assert_eq!(parse_temp(".notes.tmp-x-1"), None);
     assert_eq!(parse_temp(".a.new-1-1"), None);
 }
+
+/// A user's file named like a staging folder inside the output folder is refused, not
+/// deleted with the old set (staging folders live beside the folder, never in it).
+#[test]
+fn a_staging_like_name_inside_the_folder_is_foreign() {
+    let t = parent("staging-like");
+    let dest = t.path().join("out");
+    fs::create_dir(&dest).unwrap();
+    fs::write(dest.join(".a.json.tmp-1-0"), b"mine").unwrap();
+    let err = OutputSet::new(&dest, NAMES).unwrap_err().to_string();
+    assert!(err.contains(".a.json.tmp-1-0"), "{err}");
+    assert_eq!(listing(&dest), vec![".a.json.tmp-1-0"]);
+}
+
+/// Two runs into one new folder: the second to commit finds the folder the first created
+/// after it looked, and replaces that complete set instead of failing.
+#[test]
+fn a_folder_created_meanwhile_is_replaced() {
+    let t = parent("race");
+    let dest = t.path().join("out");
+    let first = OutputSet::new(&dest, NAMES).unwrap();
+    let second = OutputSet::new(&dest, NAMES).unwrap();
+    first.write_bytes("a.json", b"first").unwrap();
+    second.write_bytes("a.json", b"second").unwrap();
+    first.commit().unwrap();
+    // The rename the second run tries when the folder was missing a moment ago.
+    let staging = second.root.staging.clone();
+    assert!(!rename_to_new(&staging, &dest).unwrap());
+    assert!(
+        staging.exists(),
+        "the staging folder stays for the exchange"
+    );
+    second.commit().unwrap();
+    assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"second");
+    assert_eq!(listing(t.path()), vec!["out"]);
+}

@@ -180,7 +180,7 @@ impl GeometrySpec {
                 return Err(ctx.err(&field("matrix"), "give rotate_deg or matrix, not both"));
             }
             (Some(r), None) => {
-                let r = ctx.point(&field("rotate_deg"), r)?;
+                let r = ctx.angles_deg(&field("rotate_deg"), r)?;
                 DMat4::from_mat3(rotation_z(r.z) * rotation_y(r.y) * rotation_x(r.x))
             }
             (None, Some(m)) => checked_matrix(ctx, &field("matrix"), m, warnings)?,

@@ -8,7 +8,7 @@
 
 use super::geometry_file::Format;
 use crate::input_file::{read_bytes, read_text};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use glam::{DMat4, DVec3};
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
@@ -412,16 +412,43 @@ fn add_primitive(
     }
     let tag = at.tag(path, &mut out.warnings)?;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let Some(accessor) = prim.get(&gltf::Semantic::Positions) else {
+        bail!("{}: {}: no POSITION attribute", path.display(), at.place());
+    };
     let positions: Vec<DVec3> = reader
         .read_positions()
-        .with_context(|| format!("{}: {}: no POSITION attribute", path.display(), at.place()))?
+        .with_context(|| {
+            format!(
+                "{}: {}: the POSITION accessor ({} elements) does not fit its buffer view",
+                path.display(),
+                at.place(),
+                accessor.count()
+            )
+        })?
         .map(|p| world.transform_point3(DVec3::new(p[0].into(), p[1].into(), p[2].into())))
         .collect();
     let indices: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
     };
+    check_count(at, path, "POSITION", accessor.count(), positions.len())?;
+    if let Some(a) = prim.indices() {
+        check_count(at, path, "indices", a.count(), indices.len())?;
+    }
     out.push_indexed(&positions, &indices, &tag, path)
+}
+
+/// An accessor must hold as many elements as its `count` says: the reader stops at the end
+/// of the buffer view, so a larger `count` would load part of the mesh silently.
+fn check_count(at: &Primitive, path: &Path, what: &str, count: usize, read: usize) -> Result<()> {
+    if read != count {
+        bail!(
+            "{}: {}: the {what} accessor's count is {count}, but its buffer view holds {read}",
+            path.display(),
+            at.place()
+        );
+    }
+    Ok(())
 }
 
 fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
@@ -499,8 +526,10 @@ fn load_ply(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
         let list = f
             .get("vertex_indices")
             .or_else(|| f.get("vertex_index"))
-            .and_then(ply_indices)
-            .with_context(|| format!("{}: face {k} has no vertex_indices list", path.display()))?;
+            .with_context(|| format!("{}: face {k} has no vertex_indices list", path.display()))
+            .and_then(|p| {
+                ply_indices(p).map_err(|why| anyhow!("{}: face {k}: {why}", path.display()))
+            })?;
         if list.len() < 3 {
             bail!("{}: face {k} has {} vertices", path.display(), list.len());
         }
@@ -532,17 +561,28 @@ fn ply_number(p: Option<&ply_rs_bw::ply::Property>) -> Option<f64> {
     })
 }
 
-fn ply_indices(p: &ply_rs_bw::ply::Property) -> Option<Vec<u32>> {
+/// A face's vertex indices; a negative one or a property that is no list of integers is
+/// an error saying so.
+fn ply_indices(p: &ply_rs_bw::ply::Property) -> std::result::Result<Vec<u32>, String> {
     use ply_rs_bw::ply::Property as P;
-    let signed = |v: Vec<i64>| v.into_iter().map(|i| u32::try_from(i).ok()).collect();
+    fn signed<T: Copy + Into<i64>>(v: &[T]) -> std::result::Result<Vec<u32>, String> {
+        v.iter()
+            .enumerate()
+            .map(|(j, &i)| {
+                let i: i64 = i.into();
+                u32::try_from(i)
+                    .map_err(|_| format!("vertex index {i} (entry {j} of its list) is negative"))
+            })
+            .collect()
+    }
     match p {
-        P::ListInt(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
-        P::ListShort(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
-        P::ListChar(v) => signed(v.iter().map(|&i| i64::from(i)).collect()),
-        P::ListUInt(v) => Some(v.clone()),
-        P::ListUShort(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
-        P::ListUChar(v) => Some(v.iter().map(|&i| u32::from(i)).collect()),
-        _ => None,
+        P::ListInt(v) => signed(v),
+        P::ListShort(v) => signed(v),
+        P::ListChar(v) => signed(v),
+        P::ListUInt(v) => Ok(v.clone()),
+        P::ListUShort(v) => Ok(v.iter().map(|&i| u32::from(i)).collect()),
+        P::ListUChar(v) => Ok(v.iter().map(|&i| u32::from(i)).collect()),
+        _ => Err("vertex_indices is not a list of integers".into()),
     }
 }
 

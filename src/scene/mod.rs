@@ -13,6 +13,7 @@ pub mod geometry_file;
 pub mod geometry_report;
 mod hash;
 mod lamp_placement;
+mod media_checks;
 pub mod meshio;
 pub mod procedural;
 mod solids;
@@ -20,7 +21,7 @@ mod solids;
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh, spawn_epsilon};
-use crate::optics::density::check_pitch;
+use crate::optics::density::{Density, check_pitch, check_span};
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::SurfaceModel;
 use crate::sources::Sources;
@@ -122,11 +123,13 @@ impl Scene {
             ));
         }
         solids::orient_closed_solids(&ctx, &mut mesh, &tags, &surfaces, &media, &mut warnings)?;
-        warnings.extend(solids::overlap_warnings(
+        media_checks::check_media(
+            &ctx,
             &mesh,
-            |p| surfaces[mesh.tri_tag[p] as usize].interface(),
+            &tags,
+            &|p| surfaces[mesh.tri_tag[p] as usize].interface(),
             &media,
-        ));
+        )?;
         fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
         lamp_placement::check_source_media(
             &ctx,
@@ -142,7 +145,10 @@ impl Scene {
         if file.trace.max_bounces == 0 {
             return Err(ctx.err("trace.max_bounces", "must be at least 1"));
         }
-        let name = file.name.clone().unwrap_or_else(|| default_name(path));
+        let name = match &file.name {
+            Some(n) => ctx.name("name", n)?.to_owned(),
+            None => default_name(path),
+        };
         let mut scene = Scene {
             name,
             path: path.to_path_buf(),
@@ -551,7 +557,8 @@ fn fit_patterns_to_faces(
             .flat_map(|(tri, _)| tri.map(|v| mesh.positions[v as usize].distance(origin)))
             .fold(0.0, f64::max)
     };
-    let pitch_field = |tag_id: usize| format!("surfaces.{}.pitch_mm", tags[tag_id]);
+    let field = |tag_id: usize, key: &str| format!("surfaces.{}.{key}", tags[tag_id]);
+    let pitch_field = |tag_id: usize| field(tag_id, "pitch_mm");
     // All dots first, then all grooves: which error comes first does not depend on the
     // order of the tags.
     for (tag_id, s) in surfaces.iter_mut().enumerate() {
@@ -560,6 +567,13 @@ fn fit_patterns_to_faces(
             pattern.fit_to_face(ctx, &tags[tag_id], n)?;
             let r = reach(tag_id, pattern.origin);
             check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
+            let graded = pattern.gradation();
+            if !graded.is_constant() || graded.mirror {
+                check_span(ctx, &field(tag_id, "length_mm"), pattern.length, r)?;
+            }
+            if let Density::Grid(g) = &pattern.density {
+                check_span(ctx, &field(tag_id, "density_grid.width_mm"), g.width, r)?;
+            }
         }
     }
     for (tag_id, s) in surfaces.iter_mut().enumerate() {
@@ -567,6 +581,9 @@ fn fit_patterns_to_faces(
             pattern.fit_to_face(ctx, &tags[tag_id], normals(tag_id))?;
             let r = reach(tag_id, pattern.origin);
             check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
+            if !pattern.fill.is_constant() || pattern.fill.mirror {
+                check_span(ctx, &field(tag_id, "length_mm"), pattern.fill.length, r)?;
+            }
         }
     }
     Ok(())

@@ -197,50 +197,6 @@ fn signed_volume(mesh: &Mesh, p: usize) -> f64 {
     a.dot(b.cross(c)) / 6.0
 }
 
-/// Warnings where two media's closed solids overlap (one's surface passes through the
-/// other's), or where a solid lies wholly inside another medium's solid while its faces
-/// name a different medium outside. Tested with the generalized winding number of up to
-/// [`OVERLAP_SAMPLES`] vertices of each solid against every other solid (robust where a
-/// vertex lies on the other's surface: touching solids do not count).
-pub(super) fn overlap_warnings(
-    mesh: &Mesh,
-    surfaces_by_tri: impl Fn(usize) -> Option<crate::optics::medium::Interface>,
-    media: &[Medium],
-) -> Vec<String> {
-    let solids = closed_solids(mesh, &surfaces_by_tri, media.len());
-    let mut out = Vec::new();
-    for Solid {
-        medium: m, tris, ..
-    } in &solids
-    {
-        let verts = sample_vertices(mesh, tris);
-        for other in solids.iter().filter(|o| o.medium != *m) {
-            let k = &other.medium;
-            let w: Vec<f64> = verts.iter().map(|&p| winding(mesh, other, p)).collect();
-            let inside = w.iter().any(|&w| w > 0.75);
-            let outside = w.iter().any(|&w| w < 0.25);
-            let (a, b) = (&media[*m].name, &media[*k].name);
-            if inside && outside && m < k {
-                out.push(format!(
-                    "the closed solids of media '{a}' and '{b}' overlap: their surfaces cross"
-                ));
-            } else if inside && !outside {
-                let named = tris
-                    .iter()
-                    .filter_map(|&p| surfaces_by_tri(p))
-                    .any(|i| i.outside as usize != *k);
-                if named {
-                    out.push(format!(
-                        "medium '{a}' lies inside medium '{b}', but faces of '{a}' name \
-                         another medium outside them"
-                    ));
-                }
-            }
-        }
-    }
-    out
-}
-
 /// The closed solid of one medium: the faces that name it inside (oriented outward).
 pub(super) struct Solid {
     /// The medium inside.
@@ -292,13 +248,13 @@ pub(super) fn medium_at(mesh: &Mesh, solids: &[Solid], p: glam::DVec3) -> usize 
         .map_or(0, |s| s.medium)
 }
 
-/// Vertices tested per solid for overlaps.
+/// Vertices tested per solid for overlaps (`media_checks`).
 pub const OVERLAP_SAMPLES: usize = 512;
 
 /// Up to [`OVERLAP_SAMPLES`] vertices of the solid `tris`, each moved a hair into the
 /// solid (against the sum of its faces' outward normals), so that a vertex lying on
 /// another solid's surface (solids that touch) is judged by the side it really is on.
-fn sample_vertices(mesh: &Mesh, tris: &[usize]) -> Vec<glam::DVec3> {
+pub(super) fn sample_vertices(mesh: &Mesh, tris: &[usize]) -> Vec<glam::DVec3> {
     let mut normal: HashMap<u32, glam::DVec3> = HashMap::new();
     for &p in tris {
         let n = mesh.area_normal(p as u32).normalize_or_zero();
@@ -320,7 +276,7 @@ fn sample_vertices(mesh: &Mesh, tris: &[usize]) -> Vec<glam::DVec3> {
 /// 1 inside, 0 outside, 1/2 on the surface (van Oosterom and Strackee's solid angle).
 /// A point beyond the solid's box is outside without a sum over its triangles (a lamp
 /// beside a finely meshed guide would cost an `atan2` per triangle and grid point).
-fn winding(mesh: &Mesh, solid: &Solid, p: glam::DVec3) -> f64 {
+pub(super) fn winding(mesh: &Mesh, solid: &Solid, p: glam::DVec3) -> f64 {
     if !solid.bounds.contains_point(p) {
         return 0.0;
     }

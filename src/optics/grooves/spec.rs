@@ -2,7 +2,7 @@
 //! [`super`]).
 
 use super::pattern::{GroovePattern, Relief};
-use crate::optics::density::{Density, Gradation, XUnit};
+use crate::optics::density::{Density, Gradation, XUnit, check_cells};
 use crate::optics::medium::{Interface, Medium, air};
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -97,7 +97,7 @@ impl GroovesSpec {
             mirror: self.mirror,
         };
         match self.length_mm {
-            Some(l) => gradation.length = ctx.positive(&f("length_mm"), l)?,
+            Some(l) => gradation.length = ctx.length(&f("length_mm"), l)?,
             None if !gradation.is_constant() || self.mirror => {
                 return Err(ctx.err(
                     &f("length_mm"),
@@ -114,6 +114,9 @@ impl GroovesSpec {
                      (the fraction of each pitch taken by its groove)"
                 ),
             ));
+        }
+        if !gradation.is_constant() {
+            check_cells(ctx, &f("length_mm"), gradation.length, pitch)?;
         }
         let angles = GroovePattern::base_angles(apex.to_radians(), tilt.to_radians());
         Ok((

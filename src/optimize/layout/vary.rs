@@ -95,6 +95,12 @@ impl Variable {
     /// Resolve `spec` in the scene file `doc`; errors name the key.
     pub fn resolve(doc: &Value, spec: &VarySpec) -> Result<Variable> {
         let key = &spec.key;
+        if key.split('.').next() == Some("trace") {
+            bail!(
+                "--vary {key}: [trace] holds how a run is traced (photons, seed, max_bounces), \
+                 which the search sets itself (--photons, --seed); vary a number of the design"
+            );
+        }
         let mut places = Vec::new();
         expand(
             doc,
@@ -406,7 +412,8 @@ bins = [10, 10]
             ),
             ("sources.x.center.0=0..1", "expected an index or *"),
             ("detector.nope=0..1", "no key 'nope' in detector"),
-            ("trace.seed=0..1", "no key 'trace' in the scene file"),
+            ("trace.seed=0..1", "the search sets itself"),
+            ("trace.photons=1..2", "the search sets itself"),
             (
                 "sources.0.name=0..1",
                 "sources.0.name is a string, not a number",

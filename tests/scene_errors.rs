@@ -405,7 +405,10 @@ fn pattern_spans_are_bounded() {
         (
             "grid-1e300",
             grid,
-            &["surfaces.dots.density_grid", "width_mm must be at most"],
+            &[
+                "surfaces.dots.density_grid.width_mm",
+                "must be at most 1e12 mm",
+            ],
         ),
         (
             "grooves-1e20",

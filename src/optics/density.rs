@@ -290,13 +290,6 @@ impl Density {
                         crate::spec_check::short(g.width)
                     ));
                 }
-                if g.width > crate::spec_check::MAX_COORDINATE {
-                    return Some(format!(
-                        "width_mm must be at most {:e} mm, got {}",
-                        crate::spec_check::MAX_COORDINATE,
-                        crate::spec_check::short(g.width)
-                    ));
-                }
                 if !g.v_min.is_finite() {
                     return Some("v_min_mm is not a finite number".into());
                 }

@@ -118,6 +118,10 @@ impl DotsSpec {
             (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
             (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
             (None, None, Some(g)) => {
+                ctx.non_negative(&f("density_grid.width_mm"), g.width_mm)?;
+                if g.width_mm > crate::spec_check::MAX_COORDINATE {
+                    ctx.length(&f("density_grid.width_mm"), g.width_mm)?;
+                }
                 let x_max = graded_x_max(self.length_mm, self.x_unit, self.mirror);
                 (Density::Grid(g.grid(x_max)), f("density_grid"))
             }

@@ -280,7 +280,9 @@ impl Rounds {
             if rel <= target {
                 return Some(StoppedBy::TargetError);
             }
-            let undefined = rel.is_nan() || !(row.values[m] != 0.0 || row.stderr[m] > 0.0);
+            // 0/0: no value (a ratio of nothing detected is NaN), or a zero with no error.
+            let (value, err) = (row.values[m], row.stderr[m]);
+            let undefined = rel.is_nan() || !value.is_finite() || (value == 0.0 && !(err > 0.0));
             if undefined && self.traced - self.first >= UNREACHABLE_AFTER {
                 return Some(StoppedBy::Unreachable);
             }

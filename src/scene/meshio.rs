@@ -173,10 +173,13 @@ fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTr
         tobj::load_obj_buf(&mut BufReader::new(source.as_bytes()), &opts, |_| {
             tobj::load_mtl_buf(&mut BufReader::new(mtl.as_bytes()))
         })
-        .map_err(|e| anyhow::anyhow!("{}: not a valid OBJ file: {e}", path.display()))?;
+        .map_err(|e| {
+            let at = bad_obj_index(&text).unwrap_or_default();
+            anyhow!("{}: not a valid OBJ file: {e}{at}", path.display())
+        })?;
     let materials = materials.unwrap_or_default();
     let mut out = TaggedTriangles::default();
-    for m in &models {
+    for m in models.iter().filter(|m| !m.mesh.indices.is_empty()) {
         let tag = match m.mesh.material_id {
             Some(i) => materials[i].name.clone(),
             None if m.name == "unnamed_object" => tag.unwrap_or_default().to_string(),
@@ -196,6 +199,9 @@ fn load_obj(path: &Path, transform: DMat4, tag: Option<&str>) -> Result<TaggedTr
             .map(|p| transform.transform_point3(DVec3::new(p[0], p[1], p[2])))
             .collect();
         out.push_indexed(&pos, &m.mesh.indices, &tag, path)?;
+    }
+    if models.iter().all(|m| m.mesh.indices.is_empty()) {
+        bail!("{}: the OBJ file holds no triangles", path.display());
     }
     Ok(out)
 }
@@ -474,6 +480,32 @@ fn load_stl(path: &Path, transform: DMat4) -> Result<TaggedTriangles> {
     Ok(out)
 }
 
+/// Where an OBJ face names a vertex the file does not have (yet): `", line L: vertex
+/// index I, but N vertices come before it"` (negative indices count back from the line).
+fn bad_obj_index(text: &str) -> Option<String> {
+    let mut vertices: i64 = 0;
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices += 1,
+            Some("f") => {
+                for w in words {
+                    let i: i64 = w.split('/').next()?.parse().ok()?;
+                    let at = if i < 0 { vertices + i + 1 } else { i };
+                    if !(1..=vertices).contains(&at) {
+                        return Some(format!(
+                            ", line {}: vertex index {i}, but {vertices} vertices come before it",
+                            k + 1
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
 /// A binary STL's triangle count (bytes 80..84) must match its length (84 + 50 per
 /// triangle): a file cut short or with trailing triangles is damaged, not a smaller part.
 /// A file starting `solid` whose length does not fit is read as ASCII STL.
@@ -484,11 +516,17 @@ fn check_binary_stl_count(path: &Path, bytes: &[u8]) -> Result<()> {
     let count = u64::from(u32::from_le_bytes(count.try_into().unwrap_or_default()));
     let fits = bytes.len() as u64 == 84 + 50 * count;
     if !fits && !bytes.starts_with(b"solid") {
+        let body = bytes.len() as u64 - 84;
+        let rest = match body % 50 {
+            0 => String::new(),
+            r => format!(" and {r} bytes more"),
+        };
         bail!(
-            "{}: binary STL header says {count} triangles, but the file's {} bytes hold {:.1}",
+            "{}: binary STL header says {count} triangles, but the file's {} bytes hold {} \
+             (an 84-byte header, then 50 bytes a triangle){rest}",
             path.display(),
             bytes.len(),
-            (bytes.len() as f64 - 84.0) / 50.0
+            body / 50
         );
     }
     Ok(())
@@ -614,6 +652,23 @@ mod tests {
         assert_eq!(
             read(DMat4::IDENTITY, None),
             load(&path, Format::Obj, DMat4::IDENTITY, None).unwrap()
+        );
+    }
+
+    /// A face naming a vertex the file lacks is found with its line and index.
+    #[test]
+    fn a_bad_obj_index_is_named() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n";
+        let at = bad_obj_index(text).unwrap();
+        assert!(
+            at.contains("line 4: vertex index 99, but 3 vertices"),
+            "{at}"
+        );
+        assert_eq!(bad_obj_index(ONE), None);
+        assert!(
+            bad_obj_index("v 0 0 0\nf -1 -2 -3\n")
+                .unwrap()
+                .contains("index -2")
         );
     }
 }

@@ -16,7 +16,7 @@ use crate::optics::surface::Estimator;
 use crate::output::atomic::OutputSet;
 use crate::run::metrics::ScoredBins;
 use crate::run::{ConvergenceRow, MAX_SHARDS, RunOptions, RunResult, Shard, StoppedBy, metrics};
-use crate::scene::Scene;
+use crate::scene::{Scene, SharedScene};
 use crate::tally::Tally;
 use crate::tracer::CHUNK;
 use anyhow::{Context, Result, bail};
@@ -192,7 +192,9 @@ pub fn check(shards: &[(PathBuf, ShardFile)], scene: &Scene) -> Result<Vec<u64>>
 }
 
 /// Merge checked shards of `scene` into one result, as a single run would have produced.
-pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<RunResult<'a>> {
+pub fn merge(shards: &[(PathBuf, ShardFile)], scene: impl SharedScene) -> Result<RunResult> {
+    let shared = scene.shared();
+    let scene = shared.as_ref();
     let first = &shards.first().context("no shards to merge")?.1;
     let empty = Tally::new(scene);
     let mut groups = vec![empty.clone(); metrics::GROUPS];
@@ -229,7 +231,7 @@ pub fn merge<'a>(shards: &[(PathBuf, ShardFile)], scene: &'a Scene) -> Result<Ru
     };
     let backends: Vec<&str> = shards.iter().map(|(_, s)| s.backend.as_str()).collect();
     Ok(RunResult {
-        scene,
+        scene: shared.clone(),
         backend: backend_name(&backends),
         options: RunOptions {
             photons: first.photons,

@@ -34,7 +34,7 @@ fn slab(placement: &str, d: f64) -> Scene {
     edge_lit_slab(&format!("{placement}-{d}"), &dots(placement, d))
 }
 
-fn trace(scene: &Scene, photons: u64, estimator: Estimator, threads: usize) -> RunResult<'_> {
+fn trace(scene: &Scene, photons: u64, estimator: Estimator, threads: usize) -> RunResult {
     trace_opts(
         scene,
         &RunOptions {

@@ -39,7 +39,7 @@ fn photons(default: u64) -> u64 {
 fn fates(r: &RunResult) -> Vec<(String, f64)> {
     let l = &r.tally.ledger;
     let n = l.photons as f64;
-    let s = r.scene;
+    let s = &r.scene;
     let mut v = vec![
         ("detected".to_string(), l.detected.sum.value() / n),
         ("escaped".to_string(), l.escaped.value() / n),

@@ -77,7 +77,7 @@ fn reflection_transmission(r: &RunResult) -> [(f64, f64); 2] {
     ]
 }
 
-fn run(scene: &Scene, photons: u64, seed: u64, estimator: Estimator) -> RunResult<'_> {
+fn run(scene: &Scene, photons: u64, seed: u64, estimator: Estimator) -> RunResult {
     let r = trace_opts(
         scene,
         &RunOptions {

@@ -40,7 +40,7 @@ pub trait Accel: Send + Sync {
 }
 
 /// Which backend the user asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BackendChoice {
     /// The fastest backend available on this machine: Embree if its library loads, else
     /// the BVH.

@@ -18,6 +18,7 @@ mod bench;
 mod check;
 mod enums;
 pub mod optimize;
+mod optimize_flags;
 mod trace;
 
 use crate::run::Interrupt;

@@ -10,6 +10,7 @@
 //! ratio of the best design, photons and time so far), then the verification of the
 //! first and final design with error bars, and the files written.
 
+use super::optimize_flags::OptimizeFlags;
 use super::{default_out, scene_path};
 use crate::optimize::layout::EvaluationRecord;
 use crate::optimize::{
@@ -33,16 +34,13 @@ pub struct OptimizeArgs {
     pub out: Option<PathBuf>,
     /// How to optimize.
     #[command(flatten)]
-    pub options: OptimizeOptions,
+    pub flags: OptimizeFlags,
 }
 
 impl OptimizeArgs {
     /// The options these arguments ask for, with the scene's defaults.
     pub fn options(&self, scene: &Scene) -> OptimizeOptions {
-        OptimizeOptions {
-            seed: self.seed.unwrap_or(scene.default_seed),
-            ..self.options.clone()
-        }
+        self.flags.options(self.seed.unwrap_or(scene.default_seed))
     }
 }
 

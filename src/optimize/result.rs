@@ -3,9 +3,9 @@
 use super::export::{Dot, SheetFrame};
 use super::objective::Evaluation;
 use super::report::IterationReport;
-use super::traced::TracedRun;
 use super::{Method, OptimizeOptions};
 use crate::optics::dots::{Density, DotPattern, Placement};
+use crate::run::RunResult;
 use crate::run::summary::Summary;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -83,9 +83,9 @@ pub struct OptimizeResult {
     #[serde(skip)]
     pub pattern: DotPattern,
     #[serde(skip)]
-    pub(super) initial_run: TracedRun,
+    pub(super) initial_run: RunResult,
     #[serde(skip)]
-    pub(super) final_run: TracedRun,
+    pub(super) final_run: RunResult,
 }
 
 fn ser_density<S: serde::Serializer>(d: &Density, s: S) -> Result<S::Ok, S::Error> {

@@ -3,9 +3,10 @@
 use super::OptimizeOptions;
 use super::objective::{self, Evaluation};
 use super::report::IterationReport;
-use super::traced::TracedRun;
+use super::traced;
 use crate::optics::dots::{Density, DotPattern};
 use crate::optics::surface::SurfaceModel;
+use crate::run::RunResult;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
@@ -143,9 +144,9 @@ pub(super) struct Search<'a> {
     pub(super) photons: u64,
     pub(super) evaluations: usize,
     /// The first traced design.
-    pub(super) first: Option<(TracedRun, Evaluation)>,
+    pub(super) first: Option<(RunResult, Evaluation)>,
     /// The best traced design and its density.
-    pub(super) best: Option<(TracedRun, Evaluation, Density)>,
+    pub(super) best: Option<(RunResult, Evaluation, Density)>,
     /// Objective facts per evaluated parameter vector (for progress reports).
     pub(super) seen: HashMap<Vec<u64>, Evaluation>,
     pub(super) history: Vec<IterationReport>,
@@ -217,7 +218,7 @@ impl<'a> Search<'a> {
     /// Trace a design with the search's seed and photons; keeps the first and the best.
     pub(super) fn evaluate(&mut self, density: &Density) -> Result<Evaluation> {
         self.evaluations += 1;
-        let (run, ev) = TracedRun::trace(
+        let (run, ev) = traced::trace_design(
             self.scene_with(density),
             &self.run_options,
             self.strips,

@@ -2,10 +2,11 @@
 //! used and `--verify-photons` photons.
 
 use super::search::Search;
-use super::traced::TracedRun;
+use super::traced;
 use super::{Verification, VerifiedDesign};
 use crate::optics::dots::Density;
 use crate::run::RunOptions;
+use crate::run::RunResult;
 use anyhow::Result;
 
 /// Re-trace the first and the final design; returns their runs and the verification, or
@@ -14,7 +15,7 @@ pub(super) fn verify(
     search: &Search,
     initial_density: &Density,
     final_density: &Density,
-) -> Result<Option<(TracedRun, TracedRun, Verification)>> {
+) -> Result<Option<(RunResult, RunResult, Verification)>> {
     let options = search.options;
     if options.verify_photons == 0 {
         return Ok(None);
@@ -40,8 +41,8 @@ fn verify_design(
     search: &Search,
     run_options: &RunOptions,
     density: &Density,
-) -> Result<(TracedRun, VerifiedDesign)> {
-    let (run, evaluation) = TracedRun::trace(
+) -> Result<(RunResult, VerifiedDesign)> {
+    let (run, evaluation) = traced::trace_design(
         search.scene_with(density),
         run_options,
         search.strips,
@@ -49,7 +50,7 @@ fn verify_design(
         search.tag_id,
         &mut search.builds.borrow_mut(),
     )?;
-    let summary = run.result().summary();
+    let summary = run.summary();
     let design = VerifiedDesign {
         evaluation,
         summary,

@@ -95,7 +95,7 @@ impl OptimizeResult {
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
 
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
-            run.result().write_into(&staged.subdir(name)?)?;
+            run.write_into(&staged.subdir(name)?)?;
         }
         staged.commit()
     }

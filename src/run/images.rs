@@ -69,7 +69,7 @@ pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Re
 /// `angular.exr`: intensity (W/sr), and luminance (cd/m^2) when the sources give lumens.
 pub(super) fn write_angular_exr(run: &RunResult, staged: &SetDir) -> Result<()> {
     let ang = run.angular_map();
-    let lum = metrics::luminance_map(run.scene, &run.tally);
+    let lum = metrics::luminance_map(&run.scene, &run.tally);
     let mut comments = String::from(
         "blutrace angular map: Y = radiant intensity (W/sr per bin), stderr.Y = its standard \
          error, hits.Y = photons per bin",

@@ -31,7 +31,7 @@ use crate::output::{
     self,
     atomic::{OutputSet, SetDir},
 };
-use crate::scene::Scene;
+use crate::scene::{Scene, SharedScene};
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
 use anyhow::{Context, Result, bail};
@@ -45,7 +45,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// The metric a `--target-error` refers to.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TargetMetric {
     /// Mean irradiance over the target.
@@ -248,10 +248,12 @@ pub struct ConvergenceRow {
     pub stderr: MetricValues,
 }
 
-/// A finished trace.
-pub struct RunResult<'a> {
+/// A finished trace: it owns what it reports, so it can be kept, moved to another
+/// thread or handed to a caller that outlives the scene's other holders.
+#[derive(Clone, Debug)]
+pub struct RunResult {
     /// The scene traced.
-    pub scene: &'a Scene,
+    pub scene: Arc<Scene>,
     /// Backend that traced it.
     pub backend: &'static str,
     /// Options used.
@@ -319,23 +321,26 @@ pub enum Progress {
     },
 }
 
-/// Trace `scene` as `options` say. `progress` hears of every chunk and round.
-pub fn trace<'a>(
-    scene: &'a Scene,
+/// Trace `scene` (a [`Scene`], `&Scene` or `Arc<Scene>`: see [`SharedScene`]) as
+/// `options` say. `progress` hears of every chunk and round.
+pub fn trace(
+    scene: impl SharedScene,
     options: &RunOptions,
     progress: &(dyn Fn(Progress) + Sync),
-) -> Result<RunResult<'a>> {
+) -> Result<RunResult> {
     trace_reusing(scene, options, &mut MeshBuildCache::default(), progress)
 }
 
 /// [`trace`], reusing `builds`' backend and triangle records when the last run's mesh was
 /// this scene's (and leaving this run's there for the next).
-pub fn trace_reusing<'a>(
-    scene: &'a Scene,
+pub fn trace_reusing(
+    scene: impl SharedScene,
     options: &RunOptions,
     builds: &mut MeshBuildCache,
     progress: &(dyn Fn(Progress) + Sync),
-) -> Result<RunResult<'a>> {
+) -> Result<RunResult> {
+    let shared = scene.shared();
+    let scene = shared.as_ref();
     if let Some(e) = options.target_error
         && !(e > 0.0 && e.is_finite())
     {
@@ -387,7 +392,7 @@ pub fn trace_reusing<'a>(
     let start = Instant::now();
     let stopped_by = state.run(&pool, &tracer, scene, options, start, progress);
     Ok(RunResult {
-        scene,
+        scene: shared.clone(),
         backend: accel.name(),
         options: options.clone(),
         threads: pool.current_num_threads(),
@@ -419,15 +424,15 @@ pub const OUTPUT_NAMES: &[&str] = &[
     "summary.json",
 ];
 
-impl RunResult<'_> {
+impl RunResult {
     /// Target-plane irradiance (W/mm^2) per bin.
     pub fn flux_map(&self) -> Map {
-        metrics::flux_map(self.scene, &self.tally)
+        metrics::flux_map(&self.scene, &self.tally)
     }
 
     /// Radiant intensity (W/sr) per (theta, phi) bin; x = phi, y = theta.
     pub fn angular_map(&self) -> Map {
-        metrics::angular_map(self.scene, &self.tally)
+        metrics::angular_map(&self.scene, &self.tally)
     }
 
     /// Power carried by one photon of unit weight (W).

@@ -161,10 +161,10 @@ pub struct DetectorSummary {
     pub angular_bins: [usize; 2],
 }
 
-impl RunResult<'_> {
+impl RunResult {
     /// The run's summary.
     pub fn summary(&self) -> Summary {
-        let metrics = Metrics::of(self.scene, &self.tally);
+        let metrics = Metrics::of(&self.scene, &self.tally);
         let se = self
             .final_row()
             .map_or(MetricValues::splat(f64::NAN), |r| r.stderr);
@@ -250,7 +250,7 @@ impl RunResult<'_> {
                 rel_error: rel,
                 per_s: 1.0 / (rel * rel * runtime),
             },
-            luminance: super::metrics::luminance_by_theta(self.scene, &self.tally).map(|rows| {
+            luminance: super::metrics::luminance_by_theta(&self.scene, &self.tally).map(|rows| {
                 LuminanceSummary {
                     efficacy_lm_per_w: self.scene.sources.luminous_efficacy().unwrap_or(f64::NAN),
                     on_axis_cd_m2: rows[0][1],
@@ -279,7 +279,7 @@ impl RunResult<'_> {
     }
 }
 
-impl RunResult<'_> {
+impl RunResult {
     /// The ledger's pattern hits on the tags whose model is `kind` ("dots", "grooves").
     fn feature_hits(&self, kind: &str) -> BTreeMap<String, u64> {
         let l = &self.tally.ledger;

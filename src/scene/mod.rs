@@ -328,6 +328,37 @@ fn convex_solids(scene: &Scene) -> Vec<Option<ConvexSolid>> {
         .collect()
 }
 
+/// A scene a result can hold: an `Arc<Scene>` is shared as it is; a `Scene` or `&Scene`
+/// becomes one (a `&Scene` is copied once, cheap beside tracing: its mesh is shared).
+pub trait SharedScene {
+    /// The scene, shared.
+    fn shared(self) -> Arc<Scene>;
+}
+
+impl SharedScene for Arc<Scene> {
+    fn shared(self) -> Arc<Scene> {
+        self
+    }
+}
+
+impl SharedScene for &Arc<Scene> {
+    fn shared(self) -> Arc<Scene> {
+        self.clone()
+    }
+}
+
+impl SharedScene for Scene {
+    fn shared(self) -> Arc<Scene> {
+        Arc::new(self)
+    }
+}
+
+impl SharedScene for &Scene {
+    fn shared(self) -> Arc<Scene> {
+        Arc::new(self.clone())
+    }
+}
+
 fn default_name(path: &Path) -> String {
     path.parent()
         .and_then(|p| p.file_name())

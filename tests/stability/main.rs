@@ -483,7 +483,7 @@ fn scene(name: &str, toml: &str, objs: &[(&str, &str)]) -> Scene {
 }
 
 /// Trace with the BVH backend on 2 threads (convex fast path as the default says).
-fn run(scene: &Scene, photons: u64, seed: u64) -> RunResult<'_> {
+fn run(scene: &Scene, photons: u64, seed: u64) -> RunResult {
     run_with(scene, photons, seed, |_| {})
 }
 
@@ -492,7 +492,7 @@ fn run_with(
     photons: u64,
     seed: u64,
     tweak: impl FnOnce(&mut RunOptions),
-) -> RunResult<'_> {
+) -> RunResult {
     let mut o = RunOptions {
         photons,
         seed,

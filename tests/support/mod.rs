@@ -95,7 +95,7 @@ pub fn load(path: &Path) -> Scene {
 }
 
 /// Trace `photons` photons with the BVH backend.
-pub fn trace(scene: &Scene, photons: u64, seed: u64, threads: usize) -> RunResult<'_> {
+pub fn trace(scene: &Scene, photons: u64, seed: u64, threads: usize) -> RunResult {
     trace_with(scene, photons, seed, threads, BackendChoice::Bvh)
 }
 
@@ -106,7 +106,7 @@ pub fn trace_with(
     seed: u64,
     threads: usize,
     backend: BackendChoice,
-) -> RunResult<'_> {
+) -> RunResult {
     let opts = RunOptions {
         photons,
         seed,
@@ -118,7 +118,7 @@ pub fn trace_with(
 }
 
 /// Trace with options given in full.
-pub fn trace_opts<'a>(scene: &'a Scene, opts: &RunOptions) -> RunResult<'a> {
+pub fn trace_opts(scene: &Scene, opts: &RunOptions) -> RunResult {
     run::trace(scene, opts, &|_| {}).unwrap_or_else(|e| panic!("{e:#}"))
 }
 

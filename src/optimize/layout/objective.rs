@@ -125,7 +125,7 @@ impl ObjectiveSpec {
 
     /// Evaluate a finished trace.
     pub fn evaluate(&self, run: &RunResult) -> LayoutEvaluation {
-        let metrics = Metrics::of(run.scene, &run.tally);
+        let metrics = Metrics::of(&run.scene, &run.tally);
         let values = metrics.values();
         let leave_out = &run.leave_out;
         let se = |f: &dyn Fn(&MetricValues) -> f64| {

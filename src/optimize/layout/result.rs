@@ -2,8 +2,9 @@
 
 use super::objective::LayoutEvaluation;
 use super::search::{EvaluationRecord, LayoutSearch};
-use crate::optimize::traced::TracedRun;
+
 use crate::optimize::{Method, OptimizeOptions};
+use crate::run::RunResult;
 use crate::run::summary::Summary;
 use crate::run::{RunOptions, is_interrupted};
 use anyhow::Result;
@@ -118,15 +119,15 @@ pub struct LayoutResult {
     #[serde(skip)]
     pub(super) final_doc: Value,
     #[serde(skip)]
-    pub(super) initial_run: TracedRun,
+    pub(super) initial_run: RunResult,
     #[serde(skip)]
-    pub(super) final_run: TracedRun,
+    pub(super) final_run: RunResult,
 }
 
 /// Verify the scene's own design and the best one and gather the result.
 pub(super) fn finish(
     search: LayoutSearch,
-    (first_run, initial): (TracedRun, LayoutEvaluation),
+    (first_run, initial): (RunResult, LayoutEvaluation),
     best: LayoutEvaluation,
     best_x: Vec<f64>,
     cases: Vec<IntegerCase>,
@@ -144,9 +145,9 @@ pub(super) fn finish(
             seed: options.verification_seed(),
             ..search.run_options.clone()
         };
-        let verify = |x: &[f64]| -> Result<(TracedRun, VerifiedLayout)> {
+        let verify = |x: &[f64]| -> Result<(RunResult, VerifiedLayout)> {
             let (run, evaluation) = search.trace(search.design(x)?, &run_options)?;
-            let summary = run.result().summary();
+            let summary = run.summary();
             Ok((
                 run,
                 VerifiedLayout {

@@ -4,7 +4,8 @@
 use super::objective::{LayoutEvaluation, ObjectiveSpec};
 use super::vary::Variable;
 use crate::optimize::OptimizeOptions;
-use crate::optimize::traced::TracedRun;
+use crate::optimize::traced;
+use crate::run::RunResult;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use crate::scene::config::SceneFile;
@@ -62,7 +63,7 @@ pub(super) struct LayoutSearch<'a> {
     pub(super) photons: u64,
     pub(super) history: Vec<EvaluationRecord>,
     /// The best traced design: its run, evaluation and variables.
-    pub(super) best: Option<(TracedRun, LayoutEvaluation, Vec<f64>)>,
+    pub(super) best: Option<(RunResult, LayoutEvaluation, Vec<f64>)>,
     /// Objective of every design evaluated, by the bits of its variables: a design met
     /// again (the scene's own at the start of each case) is not traced twice.
     pub(super) seen: HashMap<Vec<u64>, (f64, f64)>,
@@ -104,9 +105,9 @@ impl<'a> LayoutSearch<'a> {
         &self,
         scene: Scene,
         run_options: &RunOptions,
-    ) -> Result<(TracedRun, LayoutEvaluation)> {
+    ) -> Result<(RunResult, LayoutEvaluation)> {
         let builds = &mut self.builds.borrow_mut();
-        TracedRun::trace_judged(scene, run_options, builds, |r| self.objective.evaluate(r))
+        traced::trace_judged(scene, run_options, builds, |r| self.objective.evaluate(r))
     }
 
     /// Evaluate the design `x` (inside the bounds): its objective and standard error, or

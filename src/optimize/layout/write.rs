@@ -102,7 +102,7 @@ impl LayoutResult {
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;
         for (name, run) in [("initial", &self.initial_run), ("final", &self.final_run)] {
-            run.result().write_into(&staged.subdir(name)?)?;
+            run.write_into(&staged.subdir(name)?)?;
         }
         staged.commit()
     }

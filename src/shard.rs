@@ -100,6 +100,7 @@ pub fn read_shard(path: &Path) -> Result<ShardFile> {
         path.to_path_buf()
     };
     let text = crate::input_file::read_text(&path, "shard file")?;
+    check_shapes(&path, &text)?;
     let f: ShardFile = serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}: not a shard file: {e}", path.display()))?;
     if f.format != FORMAT || f.version != FORMAT_VERSION {
@@ -120,6 +121,53 @@ pub fn read_shard(path: &Path) -> Result<ShardFile> {
         );
     }
     Ok(f)
+}
+
+/// The grid shapes of a shard file's groups, read before the tallies: a run's groups all
+/// have its detector's shape, so a file whose groups differ (each of which may claim up
+/// to [`crate::tally::MAX_GRID_BINS`] bins) is refused before any grid is allocated.
+fn check_shapes(path: &Path, text: &str) -> Result<()> {
+    #[derive(Deserialize, PartialEq, Debug)]
+    struct Dims {
+        nx: usize,
+        ny: usize,
+    }
+    #[derive(Deserialize, PartialEq, Debug)]
+    struct Shape {
+        flux: Dims,
+        angular: Dims,
+    }
+    #[derive(Deserialize)]
+    struct Shapes {
+        groups: Vec<Shape>,
+    }
+    // A file that does not parse says why in the full parse that follows.
+    let Ok(s) = serde_json::from_str::<Shapes>(text) else {
+        return Ok(());
+    };
+    if s.groups.len() != metrics::GROUPS {
+        bail!(
+            "{}: {} groups, expected {}",
+            path.display(),
+            s.groups.len(),
+            metrics::GROUPS
+        );
+    }
+    if let Some(k) = s.groups.iter().position(|g| *g != s.groups[0]) {
+        bail!(
+            "{}: groups[{k}]: its grids' shape differs from groups[0]'s: a damaged or edited shard file",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// The error of tallies whose sum leaves the counters' range.
+fn overflow(p: &Path, group: usize) -> String {
+    format!(
+        "{}: groups[{group}]: the tallies add up past what any run holds: a damaged or edited shard file",
+        p.display()
+    )
 }
 
 /// Check that `shards` belong to one run of `scene` and say which shards are missing.
@@ -215,12 +263,16 @@ pub fn merge(shards: &[(PathBuf, ShardFile)], scene: impl SharedScene) -> Result
                 );
             }
         }
-        for (g, sg) in groups.iter_mut().zip(&s.groups) {
-            g.merge(sg);
+        for (k, (g, sg)) in groups.iter_mut().zip(&s.groups).enumerate() {
+            g.checked_merge(sg).with_context(|| overflow(p, k))?;
         }
     }
     let mut total = Tally::new(scene);
-    groups.iter().for_each(|g| total.merge(g));
+    for (k, g) in groups.iter().enumerate() {
+        total
+            .checked_merge(g)
+            .with_context(|| overflow(Path::new("the shards"), k))?;
+    }
     let runtime_s: f64 = shards.iter().map(|(_, s)| s.runtime_s).sum();
     let e = metrics::estimates(scene, &total, &groups, &ScoredBins::of(&groups));
     let row = ConvergenceRow {

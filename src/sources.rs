@@ -158,7 +158,7 @@ impl SourceSpec {
             .map(|d| ctx.length(&f("package_depth_mm"), d))
             .transpose()?;
         let body = body
-            .model(ctx, &f("body"))?
+            .model(ctx, &f("body"), media)?
             .map(|model| LampBody::new(&emitter, model, depth));
         let kind = if matches!(self, SourceSpec::Ccfl { .. }) {
             "ccfl"

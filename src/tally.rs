@@ -13,6 +13,17 @@ use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 
 const FRACTION_BITS: i32 = 64;
+
+/// Most bins a stored grid may have: more than any run tallies (a run's flux and angular
+/// grids, kept once per run and once per jackknife group, fit its 4 GiB budget: at most
+/// 2.7 million bins; `run` checks the two agree), so a damaged shard file cannot make a
+/// reader allocate more than a real run did.
+pub const MAX_GRID_BINS: usize = 1 << 22;
+
+/// Most photons one stored tally may hold: its emitted weight, `photons` in 2^-64 units,
+/// and every sink within a few times that, stay far inside an `i128` (2^54 is 1.8e16
+/// photons a jackknife group, a run of 5.8e17: more than any machine traces).
+pub const MAX_STORED_PHOTONS: u64 = 1 << 54;
 const SCALE: f64 = 18446744073709551616.0; // 2^64
 
 /// Whether a merge adds another tally or takes one back out (exact: the sums are
@@ -64,6 +75,11 @@ impl ExactSum {
         sign.apply_i128(&mut self.0, other.0);
     }
 
+    /// `self + other`, or `None` past the `i128` range.
+    pub fn checked_add(self, other: ExactSum) -> Option<ExactSum> {
+        self.0.checked_add(other.0).map(ExactSum)
+    }
+
     /// The sum as f64.
     pub fn value(self) -> f64 {
         self.0 as f64 / 2f64.powi(FRACTION_BITS)
@@ -99,6 +115,14 @@ impl BinStats {
         self.sum.merge_signed(o.sum, sign);
         self.sumsq.merge_signed(o.sumsq, sign);
         sign.apply_u64(&mut self.hits, o.hits);
+    }
+
+    /// Add another bin, or `None` (self unchanged in part) past the counters' range.
+    pub fn checked_merge(&mut self, o: &BinStats) -> Option<()> {
+        self.sum = self.sum.checked_add(o.sum)?;
+        self.sumsq = self.sumsq.checked_add(o.sumsq)?;
+        self.hits = self.hits.checked_add(o.hits)?;
+        Some(())
     }
 
     /// Mean contribution per emitted photon and its standard error, for `n` photons
@@ -154,6 +178,14 @@ impl Grid {
         self.merge_signed(o, Sign::Add);
     }
 
+    /// Add another grid of the same shape, or `None` past the counters' range.
+    pub fn checked_merge(&mut self, o: &Grid) -> Option<()> {
+        self.bins
+            .iter_mut()
+            .zip(&o.bins)
+            .try_for_each(|(a, b)| a.checked_merge(b))
+    }
+
     /// Merge another grid of the same shape, or take it out.
     pub fn merge_signed(&mut self, o: &Grid, sign: Sign) {
         for (a, b) in self.bins.iter_mut().zip(&o.bins) {
@@ -193,7 +225,7 @@ impl TryFrom<SparseGrid> for Grid {
     fn try_from(s: SparseGrid) -> Result<Self, String> {
         // A stored grid is never larger than a run's tally budget allows; checked before
         // allocating, so a damaged file is an error, not an allocation abort.
-        if s.nx.checked_mul(s.ny).is_none_or(|n| n > 1 << 26) {
+        if s.nx.checked_mul(s.ny).is_none_or(|n| n > MAX_GRID_BINS) {
             return Err(format!(
                 "a {}x{} grid is larger than any run tallies",
                 s.nx, s.ny
@@ -321,31 +353,81 @@ impl Ledger {
 
     /// Add another ledger, or take it out.
     pub(crate) fn merge_signed(&mut self, o: &Ledger, sign: Sign) {
-        sign.apply_u64(&mut self.photons, o.photons);
-        sign.apply_u64(&mut self.interactions, o.interactions);
+        let done = self.combine(
+            o,
+            |a, b| {
+                a.merge_signed(b, sign);
+                Some(())
+            },
+            |a, b| {
+                sign.apply_u64(a, b);
+                Some(())
+            },
+        );
+        debug_assert!(done.is_some());
+    }
+
+    /// Add another ledger, or `None` (this one then in part merged) past the counters'
+    /// range: for ledgers read from files.
+    pub fn checked_merge(&mut self, o: &Ledger) -> Option<()> {
+        self.combine(
+            o,
+            |a, b| {
+                *a = a.checked_add(b)?;
+                Some(())
+            },
+            |a, b| {
+                *a = a.checked_add(b)?;
+                Some(())
+            },
+        )
+    }
+
+    /// Combine every counter of `o` into this ledger's: weights by `weight`, counts by
+    /// `count`, stopping at the first `None`.
+    fn combine(
+        &mut self,
+        o: &Ledger,
+        weight: impl Fn(&mut ExactSum, ExactSum) -> Option<()>,
+        count: impl Fn(&mut u64, u64) -> Option<()>,
+    ) -> Option<()> {
+        count(&mut self.photons, o.photons)?;
+        count(&mut self.interactions, o.interactions)?;
         for (mine, theirs) in [
             (&mut self.hits_by_tag, &o.hits_by_tag),
             (&mut self.feature_hits_by_tag, &o.feature_hits_by_tag),
         ] {
             for (a, b) in mine.iter_mut().zip(theirs) {
-                sign.apply_u64(a, *b);
+                count(a, *b)?;
             }
         }
-        self.emitted.merge_signed(o.emitted, sign);
-        self.detected.merge_signed(&o.detected, sign);
+        weight(&mut self.emitted, o.emitted)?;
+        weight(&mut self.detected.sum, o.detected.sum)?;
+        weight(&mut self.detected.sumsq, o.detected.sumsq)?;
+        count(&mut self.detected.hits, o.detected.hits)?;
         for (mine, theirs) in [
             (&mut self.absorbed_by_surface, &o.absorbed_by_surface),
             (&mut self.absorbed_in_medium, &o.absorbed_in_medium),
             (&mut self.absorbed_by_source, &o.absorbed_by_source),
         ] {
             for (a, b) in mine.iter_mut().zip(theirs) {
-                a.merge_signed(*b, sign);
+                weight(a, *b)?;
             }
         }
-        self.escaped.merge_signed(o.escaped, sign);
-        self.killed.merge_signed(o.killed, sign);
-        sign.apply_u64(&mut self.killed_photons, o.killed_photons);
-        self.roulette.merge_signed(o.roulette, sign);
+        weight(&mut self.escaped, o.escaped)?;
+        weight(&mut self.killed, o.killed)?;
+        count(&mut self.killed_photons, o.killed_photons)?;
+        weight(&mut self.roulette, o.roulette)
+    }
+
+    /// [`Ledger::accounted`], or `None` past the `i128` range (a damaged file's ledger).
+    pub fn checked_accounted(&self) -> Option<ExactSum> {
+        [self.detected.sum, self.escaped, self.killed, self.roulette]
+            .iter()
+            .chain(&self.absorbed_by_surface)
+            .chain(&self.absorbed_in_medium)
+            .chain(&self.absorbed_by_source)
+            .try_fold(ExactSum(0), |s, a| s.checked_add(*a))
     }
 
     /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances).
@@ -413,25 +495,35 @@ impl Tally {
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
         let negative = sinks
             .chain(&l.absorbed_by_source)
-            .chain([&l.escaped, &l.killed, &l.detected.sum])
+            .chain([&l.escaped, &l.killed, &l.detected.sum, &l.detected.sumsq])
             .any(|s| s.0 < 0);
+        let bad_bin = |g: &Grid| {
+            g.bins
+                .iter()
+                .any(|b| b.sum.0 < 0 || b.sumsq.0 < 0 || b.hits > photons)
+        };
         Some(if shape(self) != shape(empty) {
             "tally shape does not match the scene's detector, tags, media or sources".into()
         } else if l.photons != photons {
             format!("{} photons, but its range holds {photons}", l.photons)
+        } else if photons > MAX_STORED_PHOTONS {
+            format!("{photons} photons, more than {MAX_STORED_PHOTONS} (no run traces that many)")
         } else if l.emitted.0 != i128::from(photons) << FRACTION_BITS {
             format!(
                 "emitted weight {} for {photons} photons of weight 1",
                 l.emitted.value()
             )
-        } else if l.accounted() != l.emitted {
+        } else if l.checked_accounted() != Some(l.emitted) {
             format!(
                 "the ledger does not balance: emitted {} but accounted {}",
                 l.emitted.value(),
-                l.accounted().value()
+                l.checked_accounted()
+                    .map_or("more than a tally holds".into(), |a| a.value().to_string())
             )
         } else if negative || l.detected.hits > photons || l.killed_photons > photons {
             "a sink holds negative weight, or more photons than were emitted".into()
+        } else if bad_bin(&self.flux) || bad_bin(&self.angular) {
+            "a bin holds negative weight, or more photons than were emitted".into()
         } else {
             return None;
         })
@@ -440,6 +532,14 @@ impl Tally {
     /// Add another tally of the same scene.
     pub fn merge(&mut self, o: &Tally) {
         self.merge_signed(o, Sign::Add);
+    }
+
+    /// Add another tally of the same scene, or `None` past the counters' range: for
+    /// tallies read from files ([`Tally::inconsistency`] bounds each one first).
+    pub fn checked_merge(&mut self, o: &Tally) -> Option<()> {
+        self.flux.checked_merge(&o.flux)?;
+        self.angular.checked_merge(&o.angular)?;
+        self.ledger.checked_merge(&o.ledger)
     }
 
     /// Add another tally of the same scene, or take out one that is part of this one.
@@ -552,5 +652,30 @@ mod tests {
         let (m, s) = mean_and_stderr(250.0, 250.0, 1000);
         assert_eq!(m, 0.25);
         assert!((s - (0.25f64 * 0.75 / 999.0).sqrt()).abs() < 1e-15);
+    }
+
+    /// Tallies read from files add up with checked arithmetic: past the `i128` range is
+    /// `None`, never a wrapped sum or a panic.
+    #[test]
+    fn checked_merges_stop_at_the_counters_range() {
+        let mut a = Grid::new(2, 1);
+        let mut b = Grid::new(2, 1);
+        a.bins[1].sum = ExactSum(i128::MAX);
+        b.bins[1].sum = ExactSum(1);
+        assert_eq!(a.checked_merge(&b), None);
+        b.bins[1].sum = ExactSum(0);
+        b.bins[0].hits = 3;
+        assert_eq!(a.checked_merge(&b), Some(()));
+        assert_eq!(a.bins[0].hits, 3);
+        let mut l = Ledger {
+            escaped: ExactSum(i128::MAX),
+            ..Ledger::default()
+        };
+        assert_eq!(l.checked_accounted(), Some(ExactSum(i128::MAX)));
+        l.killed = ExactSum(1);
+        assert_eq!(l.checked_accounted(), None);
+        let mut m = Ledger::default();
+        assert_eq!(m.checked_merge(&l), Some(()));
+        assert_eq!(m.checked_merge(&l), None);
     }
 }

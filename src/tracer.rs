@@ -24,6 +24,7 @@ mod solid_walk;
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
 use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
+use crate::optics::absorber::Absorber;
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
@@ -279,7 +280,7 @@ impl<'a> Tracer<'a> {
         match struck {
             Struck::Surface(tag) => &self.scene.surfaces[tag as usize],
             Struck::Body(i) => &self.body(i).model,
-            Struck::BodyBack(_) => &SurfaceModel::Absorber,
+            Struck::BodyBack(_) => &SurfaceModel::Absorber(Absorber),
         }
     }
 

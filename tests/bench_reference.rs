@@ -184,8 +184,8 @@ fn altered(scene: &Scene, what: &str) -> Scene {
     let mut s = scene.clone();
     for m in &mut s.surfaces {
         match (m, what) {
-            (SurfaceModel::Dots { ink_albedo, .. }, "ink albedo x 0.95") => *ink_albedo *= 0.95,
-            (SurfaceModel::Lambert { albedo }, "sheet albedo x 0.95") => *albedo *= 0.95,
+            (SurfaceModel::Dots(d), "ink albedo x 0.95") => d.ink_albedo *= 0.95,
+            (SurfaceModel::Lambert(l), "sheet albedo x 0.95") => l.albedo *= 0.95,
             _ => {}
         }
     }

@@ -135,7 +135,7 @@ fn dots_of(scene: &Scene) -> &DotPattern {
         .surfaces
         .iter()
         .find_map(|s| match s {
-            blutrace::optics::surface::SurfaceModel::Dots { pattern, .. } => Some(pattern),
+            blutrace::optics::surface::SurfaceModel::Dots(d) => Some(&d.pattern),
             _ => None,
         })
         .expect("the scene has a dots surface")

@@ -18,7 +18,8 @@ trap 'rm -rf "$scratch"' EXIT
 # Files in the checkout beside the build's own folders, before and after the tests.
 checkout_files() {
   git status --porcelain --ignored --untracked-files=all -- . \
-    ':(exclude)target' ':(exclude)third_party' 2>/dev/null | sort
+    ':(exclude)target' ':(exclude)third_party' ':(exclude)fuzz/target' \
+    ':(exclude)fuzz/corpus' ':(exclude)fuzz/artifacts' ':(exclude)fuzz/coverage' 2>/dev/null | sort
 }
 before=$(checkout_files)
 

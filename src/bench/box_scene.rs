@@ -30,6 +30,7 @@
 use crate::geometry::Aabb;
 use crate::optics::density::{Density, graded_x};
 use crate::optics::dots::{Lattice, Placement};
+use crate::optics::lambert::Lambert;
 use crate::optics::surface::SurfaceModel;
 use crate::scene::Scene;
 use crate::sources::Emitter;
@@ -324,15 +325,11 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
     for (f, &tag) in face_tag.iter().enumerate() {
         match &scene.surfaces[tag] {
             SurfaceModel::Dielectric(_) => {}
-            SurfaceModel::Dots {
-                pattern,
-                ink_albedo,
-                ..
-            } => {
+            SurfaceModel::Dots(d) => {
                 if found.is_some() {
                     bail!(refuse(scene, "dots on more than one face"));
                 }
-                found = Some((f, pattern, *ink_albedo));
+                found = Some((f, &d.pattern, d.ink_albedo));
             }
             other => bail!(refuse(
                 scene,
@@ -409,7 +406,7 @@ fn sheet_of(scene: &Scene, prims: &[u32], tol: f64) -> Result<(AaRect, f32, usiz
     {
         bail!(refuse(scene, "more than one part besides the guide"));
     }
-    let SurfaceModel::Lambert { albedo } = scene.surfaces[tag] else {
+    let SurfaceModel::Lambert(Lambert { albedo }) = scene.surfaces[tag] else {
         bail!(refuse(
             scene,
             format!("tag '{}' is not a Lambertian sheet", scene.tags[tag])
@@ -461,10 +458,8 @@ fn strip_of(scene: &Scene) -> Result<Strip> {
     let body = match &s.body {
         None => Body::Transparent,
         Some(b) => match (&b.shape, &b.model) {
-            (BodyShape::Rectangle(_), SurfaceModel::Absorber) => Body::Absorber,
-            (BodyShape::Rectangle(_), SurfaceModel::Lambert { albedo }) => {
-                Body::Lambert(*albedo as f32)
-            }
+            (BodyShape::Rectangle(_), SurfaceModel::Absorber(_)) => Body::Absorber,
+            (BodyShape::Rectangle(_), SurfaceModel::Lambert(l)) => Body::Lambert(l.albedo as f32),
             _ => bail!(refuse(
                 scene,
                 "the LED's body must be its rectangle, absorbing or Lambertian"

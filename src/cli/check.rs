@@ -121,8 +121,8 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         .zip(scene.triangles_per_tag())
     {
         let placement = match model {
-            crate::optics::surface::SurfaceModel::Dots { pattern, .. } => {
-                format!(", {} placement", pattern.placement.name())
+            crate::optics::surface::SurfaceModel::Dots(d) => {
+                format!(", {} placement", d.pattern.placement.name())
             }
             _ => String::new(),
         };

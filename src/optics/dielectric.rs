@@ -10,6 +10,7 @@
 
 use super::fresnel;
 use super::medium::{Interface, Medium, MediumId, air};
+use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -27,10 +28,22 @@ pub struct DielectricSpec {
     pub outside: String,
 }
 
-impl DielectricSpec {
+impl SurfaceSpecOf for DielectricSpec {
     /// Check `[surfaces.TAG]`: its media.
-    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<Interface> {
-        Interface::build(ctx, tag, &self.inside, &self.outside, media)
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+        let face = Interface::build(ctx, at, &self.inside, &self.outside, media)?;
+        Ok(SurfaceModel::Dielectric(face))
+    }
+}
+
+impl Surface for Interface {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        (at.smooth(self, rng), Feature::Plain)
+    }
+
+    fn interface(&self) -> Option<Interface> {
+        Some(*self)
     }
 }
 

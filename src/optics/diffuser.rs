@@ -31,6 +31,7 @@
 
 use super::fresnel;
 use super::medium::{Interface, Medium, air};
+use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -56,10 +57,32 @@ pub struct DiffuserSpec {
     pub roughness: f64,
 }
 
-impl DiffuserSpec {
+/// A rough dielectric face: its interface and GGX roughness.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Diffuser {
+    /// The two media either side.
+    pub interface: Interface,
+    /// GGX roughness alpha (0: smooth).
+    pub roughness: f64,
+}
+
+impl Surface for Diffuser {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        let i = &self.interface;
+        let out = scatter(self.roughness, at.indices(i), at.hit.normal, at.dir, rng);
+        (at.lossless(i, out), Feature::Plain)
+    }
+
+    fn interface(&self) -> Option<Interface> {
+        Some(self.interface)
+    }
+}
+
+impl SurfaceSpecOf for DiffuserSpec {
     /// Check `[surfaces.TAG]` and build its model: the interface and the roughness.
-    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<(Interface, f64)> {
-        let field = format!("surfaces.{tag}.roughness");
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+        let field = format!("{at}.roughness");
         let alpha = ctx.non_negative(&field, self.roughness)?;
         if alpha > MAX_ROUGHNESS {
             return Err(ctx.err(
@@ -67,10 +90,10 @@ impl DiffuserSpec {
                 format!("must be at most {MAX_ROUGHNESS} (GGX alpha), got {alpha}"),
             ));
         }
-        Ok((
-            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
-            alpha,
-        ))
+        Ok(SurfaceModel::Diffuser(Diffuser {
+            interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
+            roughness: alpha,
+        }))
     }
 }
 

@@ -50,8 +50,11 @@
 
 pub use super::density::{Density, DensityGrid, XUnit};
 use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};
+use super::density::{check_pitch, check_span};
 pub use super::dot_placement::{PlacedDot, Placement};
 use super::medium::{Interface, Medium, air};
+use super::surface::{Arrival, Face, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::{DVec2, DVec3};
@@ -105,15 +108,59 @@ pub struct DotsSpec {
     pub placement_seed: Option<i64>,
 }
 
-/// A checked dots surface: the interface outside the dots, the dot layout (its `across`
-/// still zero when the file leaves it to the face, see [`DotPattern::fit_to_face`]) and
-/// the ink albedo.
-pub type Dots = (Interface, DotPattern, f64);
+/// A dielectric face with printed Lambertian ink dots.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dots {
+    /// The interface outside the dots.
+    pub interface: Interface,
+    /// The dot layout (its `across` zero until [`DotPattern::fit_to_face`] when the file
+    /// leaves it to the face).
+    pub pattern: DotPattern,
+    /// Albedo of the ink (the rest is absorbed).
+    pub ink_albedo: f64,
+}
 
-impl DotsSpec {
+impl Surface for Dots {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        if self.pattern.meets_ink(at.hit.point, rng) {
+            let ink = at.reflect(self.ink_albedo, rng, |rng| at.lambertian(rng));
+            return (ink, Feature::Ink);
+        }
+        (at.smooth(&self.interface, rng), Feature::Plain)
+    }
+
+    fn interface(&self) -> Option<Interface> {
+        Some(self.interface)
+    }
+
+    fn translate(&mut self, by: DVec3) {
+        self.pattern.origin += by;
+    }
+
+    /// The pattern's axes in the face; its pitch and spans against the face's reach
+    /// ([`check_pitch`], [`check_span`]).
+    fn fit_to_face(&mut self, ctx: &Ctx, at: &str, face: &Face) -> Result<()> {
+        let pattern = &mut self.pattern;
+        let n = face.normals().next().expect("used tag has triangles");
+        pattern.fit_to_face(ctx, at, n)?;
+        let r = face.reach(pattern.origin);
+        check_pitch(ctx, &format!("{at}.pitch_mm"), pattern.pitch, r)?;
+        let graded = pattern.gradation();
+        if !graded.is_constant() || graded.mirror {
+            check_span(ctx, &format!("{at}.length_mm"), pattern.length, r)?;
+        }
+        if let Density::Grid(g) = &pattern.density {
+            check_span(ctx, &format!("{at}.density_grid.width_mm"), g.width, r)?;
+        }
+        Ok(())
+    }
+}
+
+impl SurfaceSpecOf for DotsSpec {
     /// Check `[surfaces.TAG]` and build its model.
-    pub fn build(&self, ctx: &Ctx, tag: &str, media: &[Medium]) -> Result<Dots> {
-        let f = |k: &str| format!("surfaces.{tag}.{k}");
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+        let f = |k: &str| format!("{at}.{k}");
         let (density, field) = match (&self.density, &self.density_table, &self.density_grid) {
             (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
             (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
@@ -163,11 +210,11 @@ impl DotsSpec {
                 lattice.max_packing(), lattice
             )));
         }
-        Ok((
-            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
+        Ok(SurfaceModel::Dots(Dots {
+            interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             pattern,
-            ctx.fraction(&f("ink_albedo"), self.ink_albedo)?,
-        ))
+            ink_albedo: ctx.fraction(&f("ink_albedo"), self.ink_albedo)?,
+        }))
     }
 }
 
@@ -270,14 +317,14 @@ impl DotPattern {
         }
     }
 
-    /// Fit the pattern to its face, of unit normal `normal` (tag `tag`): `axis` must lie
-    /// in the face; `across`, when the file left it out, becomes `normal x axis`, else it
-    /// must lie in the face, perpendicular to `axis`.
-    pub fn fit_to_face(&mut self, ctx: &Ctx, tag: &str, normal: DVec3) -> Result<()> {
+    /// Fit the pattern to its face, of unit normal `normal` (its table `at`,
+    /// `surfaces.TAG`): `axis` must lie in the face; `across`, when the file left it out,
+    /// becomes `normal x axis`, else it must lie in the face, perpendicular to `axis`.
+    pub fn fit_to_face(&mut self, ctx: &Ctx, at: &str, normal: DVec3) -> Result<()> {
         let n = normal;
         if self.axis.dot(n).abs() > 1e-6 {
             return Err(ctx.err(
-                &format!("surfaces.{tag}.axis"),
+                &format!("{at}.axis"),
                 "must lie in the face (it is not perpendicular to the face normal)",
             ));
         }
@@ -285,7 +332,7 @@ impl DotPattern {
             self.across = n.cross(self.axis).normalize();
         } else if self.across.dot(n).abs() > 1e-6 || self.across.dot(self.axis).abs() > 1e-6 {
             return Err(ctx.err(
-                &format!("surfaces.{tag}.across"),
+                &format!("{at}.across"),
                 "must lie in the face, perpendicular to axis",
             ));
         }

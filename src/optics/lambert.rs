@@ -8,7 +8,9 @@
 //!
 //! The ink of [`super::dots`] and the diffuse part of [`super::phong`] reflect the same way.
 
+use super::medium::Medium;
 use super::sampling;
+use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -23,10 +25,27 @@ pub struct LambertSpec {
     pub albedo: f64,
 }
 
-impl LambertSpec {
-    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`): its albedo.
-    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<f64> {
-        ctx.fraction(&format!("{at}.albedo"), self.albedo)
+/// A Lambertian scatterer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambert {
+    /// Diffuse reflectance.
+    pub albedo: f64,
+}
+
+impl SurfaceSpecOf for LambertSpec {
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
+        let albedo = ctx.fraction(&format!("{at}.albedo"), self.albedo)?;
+        Ok(SurfaceModel::Lambert(Lambert { albedo }))
+    }
+}
+
+impl Surface for Lambert {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        (
+            at.reflect(self.albedo, rng, |rng| at.lambertian(rng)),
+            Feature::Plain,
+        )
     }
 }
 

@@ -318,21 +318,22 @@ pub fn medium_id(ctx: &Ctx, field: &str, name: &str, media: &[Medium]) -> Result
 }
 
 impl Interface {
-    /// The interface of `[surfaces.TAG]` from its `inside` and `outside` medium names.
+    /// The interface of the table at `at` (`surfaces.TAG`) from its `inside` and
+    /// `outside` medium names.
     pub fn build(
         ctx: &Ctx,
-        tag: &str,
+        at: &str,
         inside: &str,
         outside: &str,
         media: &[Medium],
     ) -> Result<Interface> {
         let face = Interface {
-            inside: medium_id(ctx, &format!("surfaces.{tag}.inside"), inside, media)?,
-            outside: medium_id(ctx, &format!("surfaces.{tag}.outside"), outside, media)?,
+            inside: medium_id(ctx, &format!("{at}.inside"), inside, media)?,
+            outside: medium_id(ctx, &format!("{at}.outside"), outside, media)?,
         };
         if face.inside == face.outside {
             return Err(ctx.err(
-                &format!("surfaces.{tag}.outside"),
+                &format!("{at}.outside"),
                 format!(
                     "is '{outside}', the medium inside too: a face between a medium and itself is no interface (name the medium in front of the face)"
                 ),

@@ -7,6 +7,9 @@
 //! ```
 
 use super::fresnel;
+use super::medium::Medium;
+use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -25,11 +28,26 @@ fn one() -> f64 {
     1.0
 }
 
-impl MirrorSpec {
-    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`): its
-    /// reflectance.
-    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<f64> {
-        ctx.fraction(&format!("{at}.reflectance"), self.reflectance)
+/// A specular mirror.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mirror {
+    /// Reflectance.
+    pub reflectance: f64,
+}
+
+impl SurfaceSpecOf for MirrorSpec {
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
+        let reflectance = ctx.fraction(&format!("{at}.reflectance"), self.reflectance)?;
+        Ok(SurfaceModel::Mirror(Mirror { reflectance }))
+    }
+}
+
+impl Surface for Mirror {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        let facing = at.facing();
+        let out = at.reflect(self.reflectance, rng, |_| Some(direction(at.dir, facing)));
+        (out, Feature::Plain)
     }
 }
 

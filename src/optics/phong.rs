@@ -11,6 +11,8 @@
 //! Of the light it reflects (the fraction `reflectance`), the fraction `specular` goes
 //! into a `cos^exponent` lobe about the mirror direction and the rest is Lambertian.
 
+use super::medium::Medium;
+use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
 use super::{fresnel, lambert, sampling};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -41,16 +43,25 @@ pub struct Phong {
     pub exponent: f64,
 }
 
-impl PhongSpec {
-    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`) and build
-    /// its model.
-    pub fn build(&self, ctx: &Ctx, at: &str) -> Result<Phong> {
+impl SurfaceSpecOf for PhongSpec {
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
         let f = |k: &str| format!("{at}.{k}");
-        Ok(Phong {
+        Ok(SurfaceModel::Phong(Phong {
             reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?,
             specular: ctx.fraction(&f("specular"), self.specular)?,
             exponent: ctx.positive(&f("exponent"), self.exponent)?,
-        })
+        }))
+    }
+}
+
+impl Surface for Phong {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        let facing = at.facing();
+        let out = at.reflect(self.reflectance, rng, |rng| {
+            self.direction(facing, at.dir, rng)
+        });
+        (out, Feature::Plain)
     }
 }
 

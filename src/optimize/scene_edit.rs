@@ -26,7 +26,8 @@ impl OptimizeResult {
     /// and other file paths made absolute, so it traces from anywhere.
     pub fn optimized_toml(&self) -> Result<String> {
         let path = &self.scene_file;
-        let mut file = read_scene_file(path)?;
+        // The file as the scene was loaded from it (not read again: it may have changed).
+        let mut file = self.initial_run.scene.file();
         let base = path.parent().unwrap_or(Path::new("."));
         make_paths_absolute(&mut file, path, base)?;
         let surface = file
@@ -62,7 +63,8 @@ pub(super) fn to_toml(file: &SceneFile) -> Result<String> {
 }
 
 /// The scene file at `path`, parsed.
-pub(super) fn read_scene_file(path: &Path) -> Result<SceneFile> {
+#[cfg(test)]
+fn read_scene_file(path: &Path) -> Result<SceneFile> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read scene file", path.display()))?;
     toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))

@@ -18,7 +18,7 @@ use std::time::Instant;
 /// The dot pattern of tag `tag_id`.
 pub(super) fn dots_pattern(scene: &Scene, tag_id: usize) -> Result<&DotPattern> {
     match scene.surfaces.get(tag_id) {
-        Some(SurfaceModel::Dots { pattern, .. }) => Ok(pattern),
+        Some(SurfaceModel::Dots(d)) => Ok(&d.pattern),
         _ => bail!("tag {tag_id} is not a dots surface"),
     }
 }
@@ -193,8 +193,8 @@ impl<'a> Search<'a> {
     /// The scene with the dots surface's density replaced.
     pub(super) fn scene_with(&self, density: &Density) -> Scene {
         let mut scene = self.scene.clone();
-        if let Some(SurfaceModel::Dots { pattern, .. }) = scene.surfaces.get_mut(self.tag_id) {
-            pattern.density = density.clone();
+        if let Some(SurfaceModel::Dots(d)) = scene.surfaces.get_mut(self.tag_id) {
+            d.pattern.density = density.clone();
         }
         scene
     }

@@ -282,7 +282,8 @@ impl Rounds {
             }
             // 0/0: no value (a ratio of nothing detected is NaN), or a zero with no error.
             let (value, err) = (row.values[m], row.stderr[m]);
-            let undefined = rel.is_nan() || !value.is_finite() || (value == 0.0 && !(err > 0.0));
+            let no_error = err.is_nan() || err <= 0.0;
+            let undefined = rel.is_nan() || !value.is_finite() || (value == 0.0 && no_error);
             if undefined && self.traced - self.first >= UNREACHABLE_AFTER {
                 return Some(StoppedBy::Unreachable);
             }

@@ -43,16 +43,9 @@
 
 pub use super::geometry_file::GeometrySpec;
 pub use super::procedural::ProceduralSpec;
-use crate::optics::absorber::AbsorberSpec;
 pub use crate::optics::density::DensityGridSpec;
-use crate::optics::dielectric::DielectricSpec;
-use crate::optics::diffuser::DiffuserSpec;
-use crate::optics::dots::DotsSpec;
-use crate::optics::grooves::GroovesSpec;
-use crate::optics::lambert::LambertSpec;
 pub use crate::optics::medium::MediumSpec;
-use crate::optics::mirror::MirrorSpec;
-use crate::optics::phong::PhongSpec;
+pub use crate::optics::surface::SurfaceSpec;
 pub use crate::sources::SourceSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -88,30 +81,6 @@ pub struct SceneFile {
     /// Tracing defaults.
     #[serde(default)]
     pub trace: TraceSpec,
-}
-
-/// The optical model of one tag: `model = "..."` picks the model, whose module owns the
-/// rest of the entry and its checks.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(tag = "model", rename_all = "lowercase")]
-pub enum SurfaceSpec {
-    /// Smooth dielectric interface ([`crate::optics::dielectric`]).
-    Dielectric(DielectricSpec),
-    /// Dielectric interface with printed ink dots ([`crate::optics::dots`]).
-    Dots(DotsSpec),
-    /// Dielectric interface carrying procedural V-grooves or prisms
-    /// ([`crate::optics::grooves`]).
-    Grooves(GroovesSpec),
-    /// Rough (diffusing) dielectric interface ([`crate::optics::diffuser`]).
-    Diffuser(DiffuserSpec),
-    /// Phong reflector ([`crate::optics::phong`]).
-    Phong(PhongSpec),
-    /// Lambertian scatterer ([`crate::optics::lambert`]).
-    Lambert(LambertSpec),
-    /// Specular mirror ([`crate::optics::mirror`]).
-    Mirror(MirrorSpec),
-    /// Black absorber ([`crate::optics::absorber`]).
-    Absorber(AbsorberSpec),
 }
 
 /// The target plane.

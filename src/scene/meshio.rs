@@ -212,8 +212,7 @@ fn load_gltf(path: &Path, transform: DMat4, tagged: bool) -> Result<TaggedTriang
     let gltf::Gltf {
         document: doc,
         blob,
-    } = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| anyhow::anyhow!("{}: not a valid glTF file: {e}", path.display()))?;
+    } = super::gltf_checks::parse(path, &bytes)?;
     let base = path.parent().unwrap_or(Path::new("."));
     for b in doc.buffers() {
         if let gltf::buffer::Source::Uri(uri) = b.source() {
@@ -417,6 +416,7 @@ fn add_primitive(
         );
     }
     let tag = at.tag(path, &mut out.warnings)?;
+    super::gltf_checks::check_mesh_accessors(prim, &at.place(), path)?;
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
     let Some(accessor) = prim.get(&gltf::Semantic::Positions) else {
         bail!("{}: {}: no POSITION attribute", path.display(), at.place());

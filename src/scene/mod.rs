@@ -11,7 +11,9 @@
 pub mod config;
 pub mod geometry_file;
 pub mod geometry_report;
+mod gltf_checks;
 mod hash;
+pub mod key_path;
 mod lamp_placement;
 mod media_checks;
 pub mod meshio;
@@ -21,13 +23,12 @@ mod solids;
 use crate::accel::convex::ConvexSolid;
 use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh, spawn_epsilon};
-use crate::optics::density::{Density, check_pitch, check_span};
 use crate::optics::medium::{self, Medium, MediumId};
-use crate::optics::surface::SurfaceModel;
+use crate::optics::surface::{Face, SurfaceModel};
 use crate::sources::Sources;
 use crate::spec_check::{Ctx, MAX_COORDINATE};
 use anyhow::{Context, Result};
-use config::{DetectorSpec, SceneFile, SurfaceSpec};
+use config::{DetectorSpec, SceneFile};
 use geometry_report::GeometryReport;
 use glam::DVec3;
 use meshio::ReadCache;
@@ -71,15 +72,19 @@ pub struct Scene {
     pub convex: Vec<Option<ConvexSolid>>,
     /// Hash of the scene file's physics sections and the tables they name.
     file_hash: u64,
+    /// The scene file as written ([`Scene::source`]; [`key_path`] reads and edits it).
+    source: toml::Value,
 }
 
 impl Scene {
     /// Load and validate the scene file at `path` and the geometry it names.
     pub fn load(path: &Path) -> Result<Scene> {
         let text = crate::input_file::read_text(path, "scene file")?;
-        let file: SceneFile =
-            toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        Self::from_file(&file, path)
+        let parse_error = |e: toml::de::Error| anyhow::anyhow!("{}: {e}", path.display());
+        // Typed from the text, so a parse error quotes its line.
+        let file: SceneFile = toml::from_str(&text).map_err(parse_error)?;
+        let source: toml::Value = toml::from_str(&text).map_err(parse_error)?;
+        Self::build(&file, source, path, &ReadCache::default())
     }
 
     /// Build a scene from an already parsed scene file; geometry paths are relative to
@@ -92,6 +97,18 @@ impl Scene {
     /// earlier scene with the same placement is copied, not parsed again (the designs of
     /// a layout search).
     pub fn from_file_reading(file: &SceneFile, path: &Path, reads: &ReadCache) -> Result<Scene> {
+        let source = toml::Value::try_from(file)
+            .with_context(|| format!("{}: cannot write the scene file", path.display()))?;
+        Self::build(file, source, path, reads)
+    }
+
+    /// Check `file` (whose document as written is `source`) and build the scene.
+    fn build(
+        file: &SceneFile,
+        source: toml::Value,
+        path: &Path,
+        reads: &ReadCache,
+    ) -> Result<Scene> {
         let ctx = Ctx(path);
         if file.version != config::SCENE_VERSION {
             return Err(ctx.err(
@@ -115,7 +132,7 @@ impl Scene {
                 .surfaces
                 .get(tag)
                 .expect("tags are checked against surfaces");
-            surfaces.push(build_surface(&ctx, tag, spec, &media)?);
+            surfaces.push(spec.build(&ctx, &format!("surfaces.{tag}"), &media)?);
         }
         for unused in file.surfaces.keys().filter(|k| !tags.contains(k)) {
             warnings.push(format!(
@@ -130,7 +147,7 @@ impl Scene {
             &|p| surfaces[mesh.tri_tag[p] as usize].interface(),
             &media,
         )?;
-        fit_patterns_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
+        fit_models_to_faces(&ctx, &mesh, &tags, &mut surfaces)?;
         lamp_placement::check_source_media(
             &ctx,
             &mesh,
@@ -167,6 +184,7 @@ impl Scene {
             geometry,
             convex: Vec::new(),
             file_hash: hash::file_hash(file, path)?,
+            source,
         };
         scene.recenter();
         scene.warnings.extend(placement_warnings(&scene));
@@ -192,12 +210,7 @@ impl Scene {
         self.sources.translate(-c);
         self.detector.origin -= c;
         for s in &mut self.surfaces {
-            if let SurfaceModel::Dots { pattern, .. } = s {
-                pattern.origin -= c;
-            }
-            if let SurfaceModel::Grooves { pattern, .. } = s {
-                pattern.origin -= c;
-            }
+            s.translate(-c);
         }
         self.offset += c;
         let extent = Aabb {
@@ -523,99 +536,20 @@ fn add_part(
 }
 
 /// Check a surface entry and build its model (each model checks its own fields).
-fn build_surface(
-    ctx: &Ctx,
-    tag: &str,
-    spec: &SurfaceSpec,
-    media: &[Medium],
-) -> Result<SurfaceModel> {
-    Ok(match spec {
-        SurfaceSpec::Dielectric(s) => SurfaceModel::Dielectric(s.build(ctx, tag, media)?),
-        SurfaceSpec::Dots(s) => {
-            let (interface, pattern, ink_albedo) = s.build(ctx, tag, media)?;
-            SurfaceModel::Dots {
-                interface,
-                pattern,
-                ink_albedo,
-            }
-        }
-        SurfaceSpec::Grooves(s) => {
-            let (interface, pattern) = s.build(ctx, tag, media)?;
-            SurfaceModel::Grooves { interface, pattern }
-        }
-        SurfaceSpec::Diffuser(s) => {
-            let (interface, roughness) = s.build(ctx, tag, media)?;
-            SurfaceModel::Diffuser {
-                interface,
-                roughness,
-            }
-        }
-        SurfaceSpec::Phong(s) => SurfaceModel::Phong(s.build(ctx, &format!("surfaces.{tag}"))?),
-        SurfaceSpec::Lambert(s) => SurfaceModel::Lambert {
-            albedo: s.build(ctx, &format!("surfaces.{tag}"))?,
-        },
-        SurfaceSpec::Mirror(s) => SurfaceModel::Mirror {
-            reflectance: s.build(ctx, &format!("surfaces.{tag}"))?,
-        },
-        SurfaceSpec::Absorber(_) => SurfaceModel::Absorber,
-    })
-}
-
-/// Fit each dot and groove pattern to its face (see [`DotPattern::fit_to_face`] and
-/// [`GroovePattern::fit_to_face`]); runs after the faces are oriented.
-///
-/// [`DotPattern::fit_to_face`]: crate::optics::dots::DotPattern::fit_to_face
-/// [`GroovePattern::fit_to_face`]: crate::optics::grooves::GroovePattern::fit_to_face
-fn fit_patterns_to_faces(
+/// Fit each tag's model to its face (a pattern's axes to the face plane, its sizes
+/// against the face: [`SurfaceModel::fit_to_face`]); runs after the faces are oriented.
+fn fit_models_to_faces(
     ctx: &Ctx,
     mesh: &Mesh,
     tags: &[String],
     surfaces: &mut [SurfaceModel],
 ) -> Result<()> {
-    let normals = |tag_id: usize| {
-        mesh.tri_tag
-            .iter()
-            .enumerate()
-            .filter(move |(_, t)| **t as usize == tag_id)
-            .map(|(p, _)| mesh.normal(p as u32))
-    };
-    // The farthest vertex of the tag's faces from `origin`.
-    let reach = |tag_id: usize, origin: DVec3| {
-        mesh.triangles
-            .iter()
-            .zip(&mesh.tri_tag)
-            .filter(|(_, t)| **t as usize == tag_id)
-            .flat_map(|(tri, _)| tri.map(|v| mesh.positions[v as usize].distance(origin)))
-            .fold(0.0, f64::max)
-    };
-    let field = |tag_id: usize, key: &str| format!("surfaces.{}.{key}", tags[tag_id]);
-    let pitch_field = |tag_id: usize| field(tag_id, "pitch_mm");
-    // All dots first, then all grooves: which error comes first does not depend on the
-    // order of the tags.
     for (tag_id, s) in surfaces.iter_mut().enumerate() {
-        if let SurfaceModel::Dots { pattern, .. } = s {
-            let n = normals(tag_id).next().expect("used tag has triangles");
-            pattern.fit_to_face(ctx, &tags[tag_id], n)?;
-            let r = reach(tag_id, pattern.origin);
-            check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
-            let graded = pattern.gradation();
-            if !graded.is_constant() || graded.mirror {
-                check_span(ctx, &field(tag_id, "length_mm"), pattern.length, r)?;
-            }
-            if let Density::Grid(g) = &pattern.density {
-                check_span(ctx, &field(tag_id, "density_grid.width_mm"), g.width, r)?;
-            }
-        }
-    }
-    for (tag_id, s) in surfaces.iter_mut().enumerate() {
-        if let SurfaceModel::Grooves { pattern, .. } = s {
-            pattern.fit_to_face(ctx, &tags[tag_id], normals(tag_id))?;
-            let r = reach(tag_id, pattern.origin);
-            check_pitch(ctx, &pitch_field(tag_id), pattern.pitch, r)?;
-            if !pattern.fill.is_constant() || pattern.fill.mirror {
-                check_span(ctx, &field(tag_id, "length_mm"), pattern.fill.length, r)?;
-            }
-        }
+        let face = Face {
+            mesh,
+            tag: tag_id as u32,
+        };
+        s.fit_to_face(ctx, &format!("surfaces.{}", tags[tag_id]), &face)?;
     }
     Ok(())
 }

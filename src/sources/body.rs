@@ -30,11 +30,9 @@
 use super::Emitter;
 use super::body_shape::{BodyHit, BodyShape};
 use crate::geometry::Ray;
-use crate::optics::absorber::AbsorberSpec;
-use crate::optics::lambert::LambertSpec;
-use crate::optics::mirror::MirrorSpec;
-use crate::optics::phong::PhongSpec;
-use crate::optics::surface::SurfaceModel;
+use crate::optics::absorber::Absorber;
+use crate::optics::medium::Medium;
+use crate::optics::surface::{SurfaceModel, SurfaceSpec};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use serde::de::{self, Deserializer, MapAccess, Visitor};
@@ -49,22 +47,9 @@ pub enum BodySpec {
     Absorber,
     /// No body: returning light passes through the lamp.
     Transparent,
-    /// An opaque surface model on the body.
-    Model(BodyModelSpec),
-}
-
-/// `body = { model = "...", ... }`: the opaque surface models a body may carry.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(tag = "model", rename_all = "lowercase")]
-pub enum BodyModelSpec {
-    /// Lambertian scatterer ([`crate::optics::lambert`]).
-    Lambert(LambertSpec),
-    /// Phong reflector ([`crate::optics::phong`]).
-    Phong(PhongSpec),
-    /// Specular mirror ([`crate::optics::mirror`]).
-    Mirror(MirrorSpec),
-    /// Black absorber ([`crate::optics::absorber`]).
-    Absorber(AbsorberSpec),
+    /// An opaque surface model on the body: any registered model whose light stays on
+    /// its side (lambert, phong, mirror, absorber), with its `[surfaces.*]` fields.
+    Model(Box<SurfaceSpec>),
 }
 
 impl Serialize for BodySpec {
@@ -105,26 +90,31 @@ impl<'de> Visitor<'de> for BodyVisitor {
     }
 
     fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<BodySpec, A::Error> {
-        BodyModelSpec::deserialize(de::value::MapAccessDeserializer::new(map)).map(BodySpec::Model)
+        SurfaceSpec::deserialize(de::value::MapAccessDeserializer::new(map))
+            .map(|s| BodySpec::Model(Box::new(s)))
     }
 }
 
 impl BodySpec {
-    /// Check `sources[i].body` and build its surface model (`None`: transparent).
-    pub fn model(&self, ctx: &Ctx, at: &str) -> Result<Option<SurfaceModel>> {
-        Ok(Some(match self {
+    /// Check `sources[i].body` (at `at`) and build its surface model (`None`:
+    /// transparent): an opaque one, light stays outside the lamp.
+    pub fn model(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Option<SurfaceModel>> {
+        let spec = match self {
             BodySpec::Transparent => return Ok(None),
-            BodySpec::Absorber | BodySpec::Model(BodyModelSpec::Absorber(_)) => {
-                SurfaceModel::Absorber
-            }
-            BodySpec::Model(BodyModelSpec::Lambert(s)) => SurfaceModel::Lambert {
-                albedo: s.build(ctx, at)?,
-            },
-            BodySpec::Model(BodyModelSpec::Phong(s)) => SurfaceModel::Phong(s.build(ctx, at)?),
-            BodySpec::Model(BodyModelSpec::Mirror(s)) => SurfaceModel::Mirror {
-                reflectance: s.build(ctx, at)?,
-            },
-        }))
+            BodySpec::Absorber => return Ok(Some(SurfaceModel::Absorber(Absorber))),
+            BodySpec::Model(spec) => spec,
+        };
+        let model = spec.build(ctx, at, media)?;
+        if model.interface().is_some() {
+            return Err(ctx.err(
+                &format!("{at}.model"),
+                format!(
+                    "'{}' lets light through; a lamp body is opaque: lambert, phong, mirror or absorber",
+                    model.kind()
+                ),
+            ));
+        }
+        Ok(Some(model))
     }
 }
 
@@ -176,8 +166,8 @@ impl LampBody {
             ),
         };
         let model = match &self.model {
-            SurfaceModel::Lambert { albedo } => format!("lambert, albedo {albedo}"),
-            SurfaceModel::Mirror { reflectance } => format!("mirror, reflectance {reflectance}"),
+            SurfaceModel::Lambert(l) => format!("lambert, albedo {}", l.albedo),
+            SurfaceModel::Mirror(m) => format!("mirror, reflectance {}", m.reflectance),
             SurfaceModel::Phong(p) => format!(
                 "phong, reflectance {}, specular {}, exponent {}",
                 p.reflectance, p.specular, p.exponent
@@ -214,15 +204,19 @@ mod tests {
             Ok(BodySpec::Transparent)
         ));
         let b = parse(r#"body = { model = "lambert", albedo = 0.45 }"#).unwrap();
-        let BodySpec::Model(BodyModelSpec::Lambert(l)) = &b else {
+        let BodySpec::Model(spec) = &b else {
+            panic!("{b:?}")
+        };
+        let SurfaceSpec::Lambert(l) = spec.as_ref() else {
             panic!("{b:?}")
         };
         assert_eq!(l.albedo, 0.45);
         let text = toml::to_string(&Holder { body: b }).unwrap();
-        assert!(matches!(
-            parse(&text),
-            Ok(BodySpec::Model(BodyModelSpec::Lambert(_)))
-        ));
+        let again = parse(&text).unwrap();
+        assert!(
+            matches!(&again, BodySpec::Model(s) if matches!(**s, SurfaceSpec::Lambert(_))),
+            "{again:?}"
+        );
     }
 
     #[test]
@@ -239,9 +233,31 @@ mod tests {
     fn albedo_is_checked_at_the_body_field() {
         let b = parse(r#"body = { model = "lambert", albedo = 1.5 }"#).unwrap();
         let e = b
-            .model(&Ctx(std::path::Path::new("s.toml")), "sources[2].body")
+            .model(&Ctx(std::path::Path::new("s.toml")), "sources[2].body", &[])
             .unwrap_err()
             .to_string();
         assert!(e.contains("s.toml: sources[2].body.albedo"), "{e}");
+    }
+
+    /// Any registered model may be a body's, as long as light stays outside the lamp.
+    #[test]
+    fn a_body_that_lets_light_through_is_refused() {
+        let media = [
+            Medium::clear("air", 1.0, 0.0),
+            Medium::clear("pmma", 1.49, 0.0),
+        ];
+        let ctx = Ctx(std::path::Path::new("s.toml"));
+        let b = parse(r#"body = { model = "dielectric", inside = "pmma" }"#).unwrap();
+        let e = b
+            .model(&ctx, "sources[0].body", &media)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("sources[0].body.model") && e.contains("lamp body is opaque"),
+            "{e}"
+        );
+        let b = parse(r#"body = { model = "mirror", reflectance = 0.9 }"#).unwrap();
+        let m = b.model(&ctx, "sources[0].body", &media).unwrap().unwrap();
+        assert_eq!(m.kind(), "mirror");
     }
 }

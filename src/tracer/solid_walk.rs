@@ -82,15 +82,11 @@ impl<'a> Walks<'a> {
             .iter()
             .map(|model| match model {
                 SurfaceModel::Dielectric(i) => Face::Smooth(smooth(i)),
-                SurfaceModel::Dots {
-                    interface,
-                    pattern,
-                    ink_albedo,
-                } => Face::Dotted {
-                    smooth: smooth(interface),
-                    pattern,
-                    radii: pattern.column_radii(),
-                    ink_albedo: *ink_albedo,
+                SurfaceModel::Dots(d) => Face::Dotted {
+                    smooth: smooth(&d.interface),
+                    pattern: &d.pattern,
+                    radii: d.pattern.column_radii(),
+                    ink_albedo: d.ink_albedo,
                 },
                 _ => Face::Other,
             })

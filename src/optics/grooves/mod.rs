@@ -82,4 +82,4 @@ mod pattern;
 mod spec;
 
 pub use pattern::{GroovePattern, MAX_CELLS, MAX_EVENTS, Relief};
-pub use spec::GroovesSpec;
+pub use spec::{Grooves, GroovesSpec};

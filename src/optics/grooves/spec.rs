@@ -2,8 +2,12 @@
 //! [`super`]).
 
 use super::pattern::{GroovePattern, Relief};
-use crate::optics::density::{Density, Gradation, XUnit, check_cells};
+use crate::optics::density::{Density, Gradation, XUnit, check_cells, check_pitch, check_span};
 use crate::optics::medium::{Interface, Medium, air};
+use crate::optics::surface::{
+    Arrival, Face, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf,
+};
+use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -50,16 +54,56 @@ pub struct GroovesSpec {
     pub mirror: bool,
 }
 
-impl GroovesSpec {
+/// A dielectric face carrying procedural V-grooves or prisms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grooves {
+    /// The two media either side of the relief.
+    pub interface: Interface,
+    /// The groove layout.
+    pub pattern: GroovePattern,
+}
+
+impl Surface for Grooves {
+    #[inline]
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        let i = &self.interface;
+        let p = &self.pattern;
+        match p.scatter_met(at.indices(i), at.hit.point, at.hit.normal, at.dir, rng) {
+            Some((d, inside, met)) => {
+                let feature = if met { Feature::Groove } else { Feature::Plain };
+                (at.lossless(i, (d, inside)), feature)
+            }
+            None => (at.smooth(i, rng), Feature::Plain),
+        }
+    }
+
+    fn interface(&self) -> Option<Interface> {
+        Some(self.interface)
+    }
+
+    fn translate(&mut self, by: DVec3) {
+        self.pattern.origin += by;
+    }
+
+    /// The pattern's axis in the (flat) face; its pitch and span against the face's
+    /// reach ([`check_pitch`], [`check_span`]).
+    fn fit_to_face(&mut self, ctx: &Ctx, at: &str, face: &Face) -> Result<()> {
+        let pattern = &mut self.pattern;
+        pattern.fit_to_face(ctx, at, face.normals())?;
+        let r = face.reach(pattern.origin);
+        check_pitch(ctx, &format!("{at}.pitch_mm"), pattern.pitch, r)?;
+        if !pattern.fill.is_constant() || pattern.fill.mirror {
+            check_span(ctx, &format!("{at}.length_mm"), pattern.fill.length, r)?;
+        }
+        Ok(())
+    }
+}
+
+impl SurfaceSpecOf for GroovesSpec {
     /// Check `[surfaces.TAG]` and build its model: the interface and the groove layout
     /// (its axis still to be fitted to the face, see [`GroovePattern::fit_to_face`]).
-    pub fn build(
-        &self,
-        ctx: &Ctx,
-        tag: &str,
-        media: &[Medium],
-    ) -> Result<(Interface, GroovePattern)> {
-        let f = |k: &str| format!("surfaces.{tag}.{k}");
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+        let f = |k: &str| format!("{at}.{k}");
         let pitch = ctx.positive(&f("pitch_mm"), self.pitch_mm)?;
         let apex = ctx.finite(&f("apex_deg"), self.apex_deg)?;
         if !(apex > 0.0 && apex < 180.0) {
@@ -119,9 +163,9 @@ impl GroovesSpec {
             check_cells(ctx, &f("length_mm"), gradation.length, pitch)?;
         }
         let angles = GroovePattern::base_angles(apex.to_radians(), tilt.to_radians());
-        Ok((
-            Interface::build(ctx, tag, &self.inside, &self.outside, media)?,
-            GroovePattern::new(
+        Ok(SurfaceModel::Grooves(Grooves {
+            interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
+            pattern: GroovePattern::new(
                 self.relief,
                 pitch,
                 angles,
@@ -129,7 +173,7 @@ impl GroovesSpec {
                 ctx.direction(&f("axis"), self.axis)?,
                 gradation,
             ),
-        ))
+        }))
     }
 }
 
@@ -141,7 +185,7 @@ impl GroovePattern {
     pub fn fit_to_face(
         &mut self,
         ctx: &Ctx,
-        tag: &str,
+        at: &str,
         normals: impl IntoIterator<Item = DVec3>,
     ) -> Result<()> {
         let mut normal = None;
@@ -149,7 +193,7 @@ impl GroovePattern {
             let first = *normal.get_or_insert(n);
             if n.dot(first).abs() < 1.0 - 1e-9 {
                 return Err(ctx.err(
-                    &format!("surfaces.{tag}"),
+                    at,
                     "model grooves needs flat faces: the tag's triangles are not all parallel",
                 ));
             }
@@ -157,7 +201,7 @@ impl GroovePattern {
         let Some(n) = normal else { return Ok(()) };
         if self.axis.dot(n).abs() > 1e-6 {
             return Err(ctx.err(
-                &format!("surfaces.{tag}.axis"),
+                &format!("{at}.axis"),
                 "must lie in the face (it is not perpendicular to the face normal)",
             ));
         }

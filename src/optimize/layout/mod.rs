@@ -37,7 +37,7 @@ use super::nelder_mead::{self, Settings};
 use super::{Method, OptimizeOptions};
 use crate::run::{RunOptions, is_interrupted};
 use crate::scene::Scene;
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use search::{LayoutSearch, PENALTY};
 use std::collections::HashMap;
 use std::time::Instant;
@@ -53,10 +53,8 @@ pub fn optimize_layout(
     options: &OptimizeOptions,
     progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
 ) -> Result<LayoutResult> {
-    let text = std::fs::read_to_string(&scene.path)
-        .with_context(|| format!("{}: cannot read scene file", scene.path.display()))?;
-    let doc: Value =
-        toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", scene.path.display()))?;
+    // The file as the scene was loaded from it (not read again: it may have changed).
+    let doc: Value = scene.source().clone();
     let vars = resolve_variables(&doc, options)?;
     check_method(options, &vars)?;
     if options.photons == 0 {

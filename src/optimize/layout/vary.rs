@@ -13,6 +13,7 @@
 //! naming the key.
 
 use crate::scene::config::SceneFile;
+use crate::scene::key_path::{self, Place, get, get_mut, kind, show};
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use toml::Value;
@@ -66,13 +67,6 @@ impl std::str::FromStr for VarySpec {
     }
 }
 
-/// One step of a resolved path.
-#[derive(Clone, Debug, PartialEq)]
-enum Step {
-    Key(String),
-    Index(usize),
-}
-
 /// A variable resolved against a scene file: the places it sets and its value there.
 #[derive(Clone, Debug, Serialize)]
 pub struct Variable {
@@ -88,7 +82,7 @@ pub struct Variable {
     pub integer: bool,
     /// Every place the variable sets (one, or every element of a `*`).
     #[serde(skip)]
-    places: Vec<Vec<Step>>,
+    places: Vec<Place>,
 }
 
 impl Variable {
@@ -101,14 +95,7 @@ impl Variable {
                  which the search sets itself (--photons, --seed); vary a number of the design"
             );
         }
-        let mut places = Vec::new();
-        expand(
-            doc,
-            &spec.key.split('.').collect::<Vec<_>>(),
-            &mut Vec::new(),
-            &mut places,
-        )
-        .with_context(|| format!("--vary {key}"))?;
+        let places = key_path::resolve(doc, key).with_context(|| format!("--vary {key}"))?;
         let values: Vec<&Value> = places.iter().map(|p| get(doc, p)).collect();
         let numbers: Vec<f64> = values
             .iter()
@@ -176,127 +163,13 @@ impl Variable {
 }
 
 /// Whether the scene file still parses with a fractional number at `places`.
-fn accepts_float(doc: &Value, places: &[Vec<Step>]) -> bool {
+fn accepts_float(doc: &Value, places: &[Place]) -> bool {
     let mut probe = doc.clone();
     for p in places {
         let v = get_mut(&mut probe, p);
         *v = Value::Float(v.as_integer().unwrap_or(0) as f64 + 0.5);
     }
     probe.try_into::<SceneFile>().is_ok()
-}
-
-/// Every concrete path `segments` names under `v` (`*` expanded), appended to `out`.
-fn expand(
-    v: &Value,
-    segments: &[&str],
-    at: &mut Vec<Step>,
-    out: &mut Vec<Vec<Step>>,
-) -> Result<()> {
-    let Some((first, rest)) = segments.split_first() else {
-        out.push(at.clone());
-        return Ok(());
-    };
-    match v {
-        Value::Table(t) => {
-            let Some(child) = t.get(*first) else {
-                let keys: Vec<&str> = t.keys().map(String::as_str).collect();
-                bail!(
-                    "no key '{first}' in {} (the file has: {}; a key left at its default \
-                     must be written into the scene file to be varied)",
-                    show_or_root(at),
-                    keys.join(", ")
-                );
-            };
-            at.push(Step::Key(first.to_string()));
-            expand(child, rest, at, out)?;
-            at.pop();
-        }
-        Value::Array(a) => {
-            let indices: Vec<usize> = if *first == "*" {
-                if a.is_empty() {
-                    bail!("{} is an empty array", show_or_root(at));
-                }
-                (0..a.len()).collect()
-            } else {
-                let i: usize = first.parse().map_err(|_| {
-                    anyhow::anyhow!(
-                        "{} is an array: expected an index or *, got '{first}'",
-                        show_or_root(at)
-                    )
-                })?;
-                if i >= a.len() {
-                    bail!(
-                        "{} has {} elements, no index {i}",
-                        show_or_root(at),
-                        a.len()
-                    );
-                }
-                vec![i]
-            };
-            for i in indices {
-                at.push(Step::Index(i));
-                expand(&a[i], rest, at, out)?;
-                at.pop();
-            }
-        }
-        other => bail!(
-            "{} is {}: nothing below it (left: {})",
-            show_or_root(at),
-            kind(other),
-            segments.join(".")
-        ),
-    }
-    Ok(())
-}
-
-fn get<'v>(mut v: &'v Value, path: &[Step]) -> &'v Value {
-    for s in path {
-        v = match s {
-            Step::Key(k) => &v[k.as_str()],
-            Step::Index(i) => &v[*i],
-        };
-    }
-    v
-}
-
-fn get_mut<'v>(mut v: &'v mut Value, path: &[Step]) -> &'v mut Value {
-    for s in path {
-        v = match s {
-            Step::Key(k) => v.get_mut(k.as_str()).expect("resolved path"),
-            Step::Index(i) => v.get_mut(*i).expect("resolved path"),
-        };
-    }
-    v
-}
-
-/// "a string", "an integer", ...
-fn kind(v: &Value) -> String {
-    let t = v.type_str();
-    let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) {
-        "an"
-    } else {
-        "a"
-    };
-    format!("{article} {t}")
-}
-
-/// A concrete path as dotted text.
-fn show(path: &[Step]) -> String {
-    path.iter()
-        .map(|s| match s {
-            Step::Key(k) => k.clone(),
-            Step::Index(i) => i.to_string(),
-        })
-        .collect::<Vec<_>>()
-        .join(".")
-}
-
-fn show_or_root(path: &[Step]) -> String {
-    if path.is_empty() {
-        "the scene file".into()
-    } else {
-        show(path)
-    }
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 //! ```
 
 use super::medium::Medium;
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -22,8 +22,10 @@ pub struct AbsorberSpec {}
 pub struct Absorber;
 
 impl SurfaceSpecOf for AbsorberSpec {
-    fn build(&self, _ctx: &Ctx, _at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
-        Ok(SurfaceModel::Absorber(Absorber))
+    type Model = Absorber;
+
+    fn build(&self, _ctx: &Ctx, _at: &str, _media: &[Medium]) -> Result<Absorber> {
+        Ok(Absorber)
     }
 }
 

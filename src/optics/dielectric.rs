@@ -10,7 +10,7 @@
 
 use super::fresnel;
 use super::medium::{Interface, Medium, MediumId, air};
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -29,21 +29,33 @@ pub struct DielectricSpec {
 }
 
 impl SurfaceSpecOf for DielectricSpec {
+    type Model = Interface;
+
     /// Check `[surfaces.TAG]`: its media.
-    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
-        let face = Interface::build(ctx, at, &self.inside, &self.outside, media)?;
-        Ok(SurfaceModel::Dielectric(face))
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Interface> {
+        Interface::build(ctx, at, &self.inside, &self.outside, media)
     }
 }
 
 impl Surface for Interface {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
-        (at.smooth(self, rng), Feature::Plain)
+        (smooth(at, self, rng), Feature::Plain)
     }
 
     fn interface(&self) -> Option<Interface> {
         Some(*self)
+    }
+}
+
+/// Fresnel roulette at the smooth interface `i` for the photon of `at`.
+#[inline]
+pub fn smooth(at: &Arrival, i: &Interface, rng: &mut PhotonRng) -> Outcome {
+    let (dir, medium) = scatter(at.media, i, at.hit.normal, at.dir, rng);
+    Outcome::Scattered {
+        dir,
+        medium,
+        weight: 1.0,
     }
 }
 

@@ -31,7 +31,7 @@
 
 use super::fresnel;
 use super::medium::{Interface, Medium, air};
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -81,7 +81,9 @@ impl Surface for Diffuser {
 
 impl SurfaceSpecOf for DiffuserSpec {
     /// Check `[surfaces.TAG]` and build its model: the interface and the roughness.
-    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Diffuser;
+
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Diffuser> {
         let field = format!("{at}.roughness");
         let alpha = ctx.non_negative(&field, self.roughness)?;
         if alpha > MAX_ROUGHNESS {
@@ -90,10 +92,10 @@ impl SurfaceSpecOf for DiffuserSpec {
                 format!("must be at most {MAX_ROUGHNESS} (GGX alpha), got {alpha}"),
             ));
         }
-        Ok(SurfaceModel::Diffuser(Diffuser {
+        Ok(Diffuser {
             interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             roughness: alpha,
-        }))
+        })
     }
 }
 

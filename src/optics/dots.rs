@@ -51,9 +51,10 @@
 pub use super::density::{Density, DensityGrid, XUnit};
 use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};
 use super::density::{check_pitch, check_span};
-pub use super::dot_placement::{PlacedDot, Placement};
 use super::medium::{Interface, Medium, air};
-use super::surface::{Arrival, Face, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+pub use super::placement::Placement;
+use super::{dielectric, lambert};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -124,10 +125,10 @@ impl Surface for Dots {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         if self.pattern.meets_ink(at.hit.point, rng) {
-            let ink = at.reflect(self.ink_albedo, rng, |rng| at.lambertian(rng));
+            let ink = at.reflect(self.ink_albedo, rng, |rng| lambert::back(at, rng));
             return (ink, Feature::Ink);
         }
-        (at.smooth(&self.interface, rng), Feature::Plain)
+        (dielectric::smooth(at, &self.interface, rng), Feature::Plain)
     }
 
     fn interface(&self) -> Option<Interface> {
@@ -159,7 +160,9 @@ impl Surface for Dots {
 
 impl SurfaceSpecOf for DotsSpec {
     /// Check `[surfaces.TAG]` and build its model.
-    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Dots;
+
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Dots> {
         let f = |k: &str| format!("{at}.{k}");
         let (density, field) = match (&self.density, &self.density_table, &self.density_grid) {
             (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
@@ -210,11 +213,11 @@ impl SurfaceSpecOf for DotsSpec {
                 lattice.max_packing(), lattice
             )));
         }
-        Ok(SurfaceModel::Dots(Dots {
+        Ok(Dots {
             interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             pattern,
             ink_albedo: ctx.fraction(&f("ink_albedo"), self.ink_albedo)?,
-        }))
+        })
     }
 }
 

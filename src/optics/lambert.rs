@@ -9,8 +9,8 @@
 //! The ink of [`super::dots`] and the diffuse part of [`super::phong`] reflect the same way.
 
 use super::medium::Medium;
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::sampling;
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -33,9 +33,11 @@ pub struct Lambert {
 }
 
 impl SurfaceSpecOf for LambertSpec {
-    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Lambert;
+
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Lambert> {
         let albedo = ctx.fraction(&format!("{at}.albedo"), self.albedo)?;
-        Ok(SurfaceModel::Lambert(Lambert { albedo }))
+        Ok(Lambert { albedo })
     }
 }
 
@@ -43,10 +45,16 @@ impl Surface for Lambert {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         (
-            at.reflect(self.albedo, rng, |rng| at.lambertian(rng)),
+            at.reflect(self.albedo, rng, |rng| back(at, rng)),
             Feature::Plain,
         )
     }
+}
+
+/// A Lambertian direction back into the side the photon of `at` came from.
+#[inline]
+pub fn back(at: &Arrival, rng: &mut PhotonRng) -> Option<DVec3> {
+    Some(direction(at.facing(), rng))
 }
 
 /// A Lambertian direction about the unit normal `facing` (the paper's equation (1)).

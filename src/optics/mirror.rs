@@ -8,7 +8,7 @@
 
 use super::fresnel;
 use super::medium::Medium;
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -36,9 +36,11 @@ pub struct Mirror {
 }
 
 impl SurfaceSpecOf for MirrorSpec {
-    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Mirror;
+
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Mirror> {
         let reflectance = ctx.fraction(&format!("{at}.reflectance"), self.reflectance)?;
-        Ok(SurfaceModel::Mirror(Mirror { reflectance }))
+        Ok(Mirror { reflectance })
     }
 }
 

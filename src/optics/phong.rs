@@ -12,7 +12,7 @@
 //! into a `cos^exponent` lobe about the mirror direction and the rest is Lambertian.
 
 use super::medium::Medium;
-use super::surface::{Arrival, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf};
+use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::{fresnel, lambert, sampling};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -44,13 +44,15 @@ pub struct Phong {
 }
 
 impl SurfaceSpecOf for PhongSpec {
-    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Phong;
+
+    fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Phong> {
         let f = |k: &str| format!("{at}.{k}");
-        Ok(SurfaceModel::Phong(Phong {
+        Ok(Phong {
             reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?,
             specular: ctx.fraction(&f("specular"), self.specular)?,
             exponent: ctx.positive(&f("exponent"), self.exponent)?,
-        }))
+        })
     }
 }
 

@@ -3,7 +3,7 @@
 use super::OptimizeOptions;
 use super::objective::{self, Evaluation};
 use super::report::IterationReport;
-use super::traced;
+use super::traced::{self, dots_pattern};
 use crate::optics::dots::{Density, DotPattern};
 use crate::optics::surface::SurfaceModel;
 use crate::run::RunResult;
@@ -14,14 +14,6 @@ use glam::DVec3;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::time::Instant;
-
-/// The dot pattern of tag `tag_id`.
-pub(super) fn dots_pattern(scene: &Scene, tag_id: usize) -> Result<&DotPattern> {
-    match scene.surfaces.get(tag_id) {
-        Some(SurfaceModel::Dots(d)) => Ok(&d.pattern),
-        _ => bail!("tag {tag_id} is not a dots surface"),
-    }
-}
 
 /// The tag index of the dots surface to optimize.
 fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {

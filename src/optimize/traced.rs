@@ -2,10 +2,11 @@
 //! `initial/` and `final/`) and what the search makes of it.
 
 use super::objective::Evaluation;
-use super::search::dots_pattern;
+use crate::optics::dots::DotPattern;
+use crate::optics::surface::SurfaceModel;
 use crate::run::{self, Interrupted, MeshBuildCache, RunOptions, RunResult, StoppedBy};
 use crate::scene::Scene;
-use anyhow::Result;
+use anyhow::{Result, bail};
 
 /// Trace `scene`; returns the run and its evaluation.
 pub(super) fn trace_design(
@@ -46,4 +47,12 @@ pub(super) fn trace_judged<T>(
     }
     let judged = judge(&r);
     Ok((r, judged))
+}
+
+/// The dot pattern of tag `tag_id`.
+pub(super) fn dots_pattern(scene: &Scene, tag_id: usize) -> Result<&DotPattern> {
+    match scene.surfaces.get(tag_id) {
+        Some(SurfaceModel::Dots(d)) => Ok(&d.pattern),
+        _ => bail!("tag {tag_id} is not a dots surface"),
+    }
 }

@@ -24,6 +24,7 @@
 //! (negative determinant) keeps faces outward by reversing their winding; a singular one
 //! is refused; one that shears or stretches unevenly is accepted with a warning.
 
+pub use super::meshio::Format;
 use super::meshio::{ReadCache, TaggedTriangles};
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -100,51 +101,19 @@ pub enum UpAxis {
     Y,
 }
 
-/// Geometry file formats, by file extension.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Format {
-    /// Wavefront OBJ (tags: `usemtl`, else `o`/`g` names).
-    Obj,
-    /// glTF 2.0, `.gltf` or `.glb` (tags: material names).
-    Gltf,
-    /// STL, ASCII or binary (no tags).
-    Stl,
-    /// PLY, ASCII or binary (no tags).
-    Ply,
+/// The units a format's specification prescribes, else millimetres.
+fn default_units(format: Format) -> Units {
+    match format {
+        Format::Gltf => Units::M,
+        _ => Units::Mm,
+    }
 }
 
-impl Format {
-    /// The format of `path`, from its extension.
-    pub fn of(path: &Path) -> Option<Format> {
-        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        Some(match ext.as_str() {
-            "obj" => Format::Obj,
-            "gltf" | "glb" => Format::Gltf,
-            "stl" => Format::Stl,
-            "ply" => Format::Ply,
-            _ => return None,
-        })
-    }
-
-    /// The units its specification prescribes, else millimetres.
-    fn default_units(self) -> Units {
-        match self {
-            Format::Gltf => Units::M,
-            _ => Units::Mm,
-        }
-    }
-
-    /// The up axis its specification prescribes, else z.
-    fn default_up(self) -> UpAxis {
-        match self {
-            Format::Gltf => UpAxis::Y,
-            _ => UpAxis::Z,
-        }
-    }
-
-    /// True when the format carries no material names, so a file needs `tag`.
-    pub fn untagged(self) -> bool {
-        matches!(self, Format::Stl | Format::Ply)
+/// The up axis a format's specification prescribes, else z.
+fn default_up(format: Format) -> UpAxis {
+    match format {
+        Format::Gltf => UpAxis::Y,
+        _ => UpAxis::Z,
     }
 }
 
@@ -170,8 +139,8 @@ impl GeometrySpec {
         let field = |f: &str| format!("geometry[{i}].{f}");
         let scale = ctx.positive(&field("scale"), self.scale)?;
         let shift = ctx.point(&field("translate"), self.translate)?;
-        let units = self.units.unwrap_or(format.default_units()).mm();
-        let up = match self.up.unwrap_or(format.default_up()) {
+        let units = self.units.unwrap_or(default_units(format)).mm();
+        let up = match self.up.unwrap_or(default_up(format)) {
             UpAxis::Z => DMat3::IDENTITY,
             UpAxis::Y => rotation_x(90.0),
         };

@@ -6,7 +6,6 @@
 //! scene's `tag` replaces them all. glTF node transforms are applied, then the placement
 //! the scene file gives ([`super::geometry_file`]).
 
-use super::geometry_file::Format;
 use crate::input_file::{read_bytes, read_text};
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DMat4, DVec3};
@@ -145,6 +144,38 @@ pub fn load(
         tris.tags.iter_mut().for_each(|t| *t = tag.to_string());
     }
     Ok(tris)
+}
+
+/// Geometry file formats, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Wavefront OBJ (tags: `usemtl`, else `o`/`g` names).
+    Obj,
+    /// glTF 2.0, `.gltf` or `.glb` (tags: material names).
+    Gltf,
+    /// STL, ASCII or binary (no tags).
+    Stl,
+    /// PLY, ASCII or binary (no tags).
+    Ply,
+}
+
+impl Format {
+    /// The format of `path`, from its extension.
+    pub fn of(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "obj" => Format::Obj,
+            "gltf" | "glb" => Format::Gltf,
+            "stl" => Format::Stl,
+            "ply" => Format::Ply,
+            _ => return None,
+        })
+    }
+
+    /// True when the format carries no material names, so a file needs `tag`.
+    pub fn untagged(self) -> bool {
+        matches!(self, Format::Stl | Format::Ply)
+    }
 }
 
 /// Untagged triangles read by a format without material names (tagged by the caller).

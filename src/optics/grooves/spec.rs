@@ -3,10 +3,9 @@
 
 use super::pattern::{GroovePattern, Relief};
 use crate::optics::density::{Density, Gradation, XUnit, check_cells, check_pitch, check_span};
+use crate::optics::dielectric;
 use crate::optics::medium::{Interface, Medium, air};
-use crate::optics::surface::{
-    Arrival, Face, Feature, Outcome, Surface, SurfaceModel, SurfaceSpecOf,
-};
+use crate::optics::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -73,7 +72,7 @@ impl Surface for Grooves {
                 let feature = if met { Feature::Groove } else { Feature::Plain };
                 (at.lossless(i, (d, inside)), feature)
             }
-            None => (at.smooth(i, rng), Feature::Plain),
+            None => (dielectric::smooth(at, i, rng), Feature::Plain),
         }
     }
 
@@ -102,7 +101,9 @@ impl Surface for Grooves {
 impl SurfaceSpecOf for GroovesSpec {
     /// Check `[surfaces.TAG]` and build its model: the interface and the groove layout
     /// (its axis still to be fitted to the face, see [`GroovePattern::fit_to_face`]).
-    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {
+    type Model = Grooves;
+
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Grooves> {
         let f = |k: &str| format!("{at}.{k}");
         let pitch = ctx.positive(&f("pitch_mm"), self.pitch_mm)?;
         let apex = ctx.finite(&f("apex_deg"), self.apex_deg)?;
@@ -163,7 +164,7 @@ impl SurfaceSpecOf for GroovesSpec {
             check_cells(ctx, &f("length_mm"), gradation.length, pitch)?;
         }
         let angles = GroovePattern::base_angles(apex.to_radians(), tilt.to_radians());
-        Ok(SurfaceModel::Grooves(Grooves {
+        Ok(Grooves {
             interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             pattern: GroovePattern::new(
                 self.relief,
@@ -173,7 +174,7 @@ impl SurfaceSpecOf for GroovesSpec {
                 ctx.direction(&f("axis"), self.axis)?,
                 gradation,
             ),
-        }))
+        })
     }
 }
 

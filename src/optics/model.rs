@@ -1,0 +1,172 @@
+//! What every surface model implements: its scene-file table checks itself and builds
+//! the model ([`SurfaceSpecOf`]), and the model says what a photon meets at its surface
+//! ([`Surface`], given the photon's [`Arrival`]). The models live in their own modules
+//! and are registered in [`super::surface`].
+
+use super::medium::{Interface, Medium, MediumId};
+use crate::estimator::Estimator;
+use crate::geometry::{Mesh, SurfaceHit};
+use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use std::path::PathBuf;
+
+/// A model's scene-file table: it checks itself and builds the model.
+pub trait SurfaceSpecOf {
+    /// The model it builds.
+    type Model;
+
+    /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`, whose
+    /// fields are named `AT.FIELD` in errors) and build the model.
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Self::Model>;
+
+    /// The files the model reads (measured tables), relative to the scene file: the
+    /// content hash covers their bytes, so shards of a changed table do not merge.
+    fn files(&self) -> Vec<PathBuf> {
+        Vec::new()
+    }
+}
+
+/// A model's physics: what a photon meets at its surface.
+pub trait Surface {
+    /// Roulette the fate of the photon arriving as `at` says; and what part of a
+    /// patterned face it met.
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature);
+
+    /// The two media of a dielectric-like face (`None`: opaque, light stays on its side).
+    fn interface(&self) -> Option<Interface> {
+        None
+    }
+
+    /// Move the model's anchor points (a pattern's origin) with the scene by `by` (mm).
+    fn translate(&mut self, _by: DVec3) {}
+
+    /// Fit the model to the face it lies on and check it against the face.
+    fn fit_to_face(&mut self, _ctx: &Ctx, _at: &str, _face: &Face) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// The triangles of one tag, as a model fits itself to them.
+pub struct Face<'a> {
+    /// The scene's mesh.
+    pub mesh: &'a Mesh,
+    /// The tag's index in the mesh.
+    pub tag: u32,
+}
+
+impl Face<'_> {
+    /// The unit normals of the face's triangles (oriented outward by then).
+    pub fn normals(&self) -> impl Iterator<Item = DVec3> + '_ {
+        self.triangles().map(|p| self.mesh.normal(p))
+    }
+
+    /// The farthest vertex of the face from `origin` (mm).
+    pub fn reach(&self, origin: DVec3) -> f64 {
+        self.triangles()
+            .flat_map(|p| self.mesh.corners(p).map(|v| v.distance(origin)))
+            .fold(0.0, f64::max)
+    }
+
+    fn triangles(&self) -> impl Iterator<Item = u32> + '_ {
+        let tag = self.tag;
+        (0..self.mesh.len() as u32).filter(move |&p| self.mesh.tri_tag[p as usize] == tag)
+    }
+}
+
+/// A photon arriving at a surface: what every model's [`Surface::interact`] reads.
+pub struct Arrival<'a> {
+    /// The scene's media.
+    pub media: &'a [Medium],
+    /// Where it hit (point, outward unit normal).
+    pub hit: &'a SurfaceHit,
+    /// Its unit direction.
+    pub dir: DVec3,
+    /// The medium it travels in.
+    pub medium: MediumId,
+    /// Analog roulette or absorption by weights.
+    pub est: Estimator,
+}
+
+impl Arrival<'_> {
+    /// The unit normal on the side the photon came from.
+    #[inline]
+    pub fn facing(&self) -> DVec3 {
+        if self.dir.dot(self.hit.normal) < 0.0 {
+            self.hit.normal
+        } else {
+            -self.hit.normal
+        }
+    }
+
+    /// An opaque reflection: survival of the albedo by the estimator, then a direction
+    /// from `sample` back into the photon's medium (`None`: absorbed there).
+    #[inline]
+    pub fn reflect(
+        &self,
+        albedo: f64,
+        rng: &mut PhotonRng,
+        sample: impl FnOnce(&mut PhotonRng) -> Option<DVec3>,
+    ) -> Outcome {
+        let Some(weight) = self.est.survive(albedo, rng) else {
+            return Outcome::Absorbed;
+        };
+        match sample(rng) {
+            Some(dir) => Outcome::Scattered {
+                dir,
+                medium: self.medium,
+                weight,
+            },
+            None => Outcome::Absorbed,
+        }
+    }
+
+    /// A lossless interface's outcome: the photon leaves along `dir` into `i`'s inside
+    /// or outside medium.
+    #[inline]
+    pub fn lossless(&self, i: &Interface, (dir, inside): (DVec3, bool)) -> Outcome {
+        Outcome::Scattered {
+            dir,
+            medium: if inside { i.inside } else { i.outside },
+            weight: 1.0,
+        }
+    }
+
+    /// The refractive indices inside and outside `i`.
+    #[inline]
+    pub fn indices(&self, i: &Interface) -> (f64, f64) {
+        (
+            self.media[i.inside as usize].n,
+            self.media[i.outside as usize].n,
+        )
+    }
+}
+
+/// What a surface did to a photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Outcome {
+    /// The photon leaves in `dir`, now travelling in `medium`, its weight multiplied by
+    /// `weight` (1 in analog mode; the surface's reflectance when absorption is weighted).
+    Scattered {
+        /// New unit direction.
+        dir: DVec3,
+        /// Medium the photon now travels in.
+        medium: MediumId,
+        /// Factor applied to the photon's weight.
+        weight: f64,
+    },
+    /// The photon was absorbed by this surface.
+    Absorbed,
+}
+
+/// What part of a patterned face a hit met (see `SurfaceModel::interact_on`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Feature {
+    /// The plain surface (every unpatterned model, and dotted faces between dots).
+    Plain,
+    /// Ink of a dots pattern.
+    Ink,
+    /// A groove (or prism) of a grooves pattern.
+    Groove,
+}

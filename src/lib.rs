@@ -3,11 +3,12 @@
 //! One module per physical concept: [`scene`] (files and validation), [`geometry`],
 //! [`accel`] (intersection backends), [`optics`] (surface models), [`sources`],
 //! [`tracer`] (the photon loop), [`detector`] and [`tally`] (what is scored),
-//! [`output`] (EXR, PNG, JSON) and [`run`] (a whole traced job with its summary).
+//! [`output`] (EXR, PNG, JSON), [`run`] (a whole traced job with its summary) and
+//! [`optimize`] (the dot and layout searches). The command line is the `blutrace` binary's
+//! own (`src/cli/`, over this library); `examples/design_study.rs` uses the library.
 
 pub mod accel;
 pub mod bench;
-pub mod cli;
 pub mod count;
 pub mod detector;
 pub mod estimator;

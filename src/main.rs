@@ -1,5 +1,8 @@
-//! The `blutrace` binary: the command line lives in the library ([`blutrace::cli`]).
+//! The `blutrace` binary: the command line ([`cli`]), one file a subcommand, over the
+//! `blutrace` library.
+
+mod cli;
 
 fn main() -> std::process::ExitCode {
-    blutrace::cli::main()
+    cli::main()
 }

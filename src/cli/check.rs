@@ -1,11 +1,11 @@
 //! `blutrace check`: validate a scene and print what it uses, per geometry file and tag
 //! with sizes in mm (or `--json` for scripts).
 
-use crate::accel::BackendChoice;
-use crate::optics::medium::Medium;
-use crate::scene::Scene;
-use crate::scene::geometry_report::BoxMm;
 use anyhow::Result;
+use blutrace::accel::BackendChoice;
+use blutrace::optics::medium::Medium;
+use blutrace::scene::Scene;
+use blutrace::scene::geometry_report::BoxMm;
 use std::path::Path;
 
 /// "  x from .. to .. mm" for a check line.
@@ -74,7 +74,7 @@ fn medium_json(m: &Medium) -> serde_json::Value {
 
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     let scene = Scene::load(path)?;
-    let tally_bytes = crate::run::check_tally_budget(&scene)?;
+    let tally_bytes = blutrace::run::check_tally_budget(&scene)?;
     if json {
         let report = serde_json::json!({
             "scene": scene.name,
@@ -121,7 +121,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         .zip(scene.triangles_per_tag())
     {
         let placement = match model {
-            crate::optics::surface::SurfaceModel::Dots(d) => {
+            blutrace::optics::surface::SurfaceModel::Dots(d) => {
                 format!(", {} placement", d.pattern.placement.name())
             }
             _ => String::new(),
@@ -145,7 +145,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             scattering(m)
         );
     }
-    let backend = crate::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
+    let backend = blutrace::accel::build(BackendChoice::Auto, scene.mesh.clone())?;
     say!("backend    auto picks {}", backend.name());
     for s in &scene.sources.list {
         let body = s
@@ -169,7 +169,7 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         d.angular_bins[0],
         d.angular_bins[1],
         tally_bytes as f64 / (1u64 << 20) as f64,
-        crate::run::TALLY_BUDGET_BYTES >> 30
+        blutrace::run::TALLY_BUDGET_BYTES >> 30
     );
     say!(
         "trace      {} photons, seed {}, bounce cap {}",

@@ -21,8 +21,8 @@ pub mod optimize;
 mod optimize_flags;
 mod trace;
 
-use crate::run::Interrupt;
 use anyhow::Result;
+use blutrace::run::Interrupt;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -53,7 +53,7 @@ enum Command {
     /// Measure photons/s per backend (ratios in one run; see the README's table).
     Bench {
         /// Photons per configuration.
-        #[arg(long, default_value_t = 200_000, value_parser = crate::count::parse_photons)]
+        #[arg(long, default_value_t = 200_000, value_parser = blutrace::count::parse_photons)]
         photons: u64,
         /// Worker threads (default: all cores).
         #[arg(long)]
@@ -66,7 +66,7 @@ enum Command {
         #[arg(long)]
         box_scene: Option<PathBuf>,
         /// Rounds per timing (each round measures every configuration once; medians).
-        #[arg(long, default_value_t = 3, value_parser = crate::count::parse_rounds)]
+        #[arg(long, default_value_t = 3, value_parser = blutrace::count::parse_rounds)]
         repeat: usize,
     },
     /// Validate a scene and print what it uses.

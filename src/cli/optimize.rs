@@ -12,12 +12,12 @@
 
 use super::optimize_flags::OptimizeFlags;
 use super::{default_out, scene_path};
-use crate::optimize::layout::EvaluationRecord;
-use crate::optimize::{
+use anyhow::Result;
+use blutrace::optimize::layout::EvaluationRecord;
+use blutrace::optimize::{
     LayoutResult, OptimizeOptions, OptimizeResult, VerifiedDesign, optimize, optimize_layout,
 };
-use crate::scene::Scene;
-use anyhow::Result;
+use blutrace::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -70,7 +70,7 @@ pub fn run(args: OptimizeArgs, quiet: bool) -> Result<ExitCode> {
             );
             Ok(ExitCode::from(130))
         }
-        Err(e) if crate::run::is_interrupted(&e) => {
+        Err(e) if blutrace::run::is_interrupted(&e) => {
             eprintln!("interrupted before the first design was traced: nothing written");
             Ok(ExitCode::from(130))
         }
@@ -92,7 +92,7 @@ fn run_density(
             scene.name, options.method
         ))
     });
-    crate::output::atomic::check_dest(&out, crate::optimize::OUTPUT_NAMES)?;
+    blutrace::output::atomic::check_dest(&out, blutrace::optimize::OUTPUT_NAMES)?;
     let objective = if options.tunes_grid() {
         "area cv of the flux map (2-D density grid)"
     } else {
@@ -131,7 +131,7 @@ fn run_layout(
             scene.name, options.method
         ))
     });
-    crate::output::atomic::check_dest(&out, crate::optimize::LAYOUT_OUTPUT_NAMES)?;
+    blutrace::output::atomic::check_dest(&out, blutrace::optimize::LAYOUT_OUTPUT_NAMES)?;
     say!(
         "optimize   {} ({}) by {} over {} variable(s): {} photons per design, seed {}, objective = {}",
         scene.name,
@@ -288,14 +288,14 @@ pub fn print_report(r: &OptimizeResult) {
         r.options.photons
     );
     match &r.final_density {
-        crate::optics::dots::Density::Polynomial(c) => {
+        blutrace::optics::dots::Density::Polynomial(c) => {
             let c: Vec<String> = c.iter().map(|v| format!("{v:.6}")).collect();
             say!("density    polynomial [{}]", c.join(", "));
         }
-        crate::optics::dots::Density::Table(k) => {
+        blutrace::optics::dots::Density::Table(k) => {
             say!("density    table of {} knots", k.len());
         }
-        crate::optics::dots::Density::Grid(g) => {
+        blutrace::optics::dots::Density::Grid(g) => {
             let (nx, ny) = g.shape();
             say!("density    grid of {nx} x {ny} knots (along x across)");
         }

@@ -2,18 +2,19 @@
 //! [`OptimizeOptions`] (one field each; the defaults are the library's, stated here for
 //! `--help`).
 
-use crate::accel::BackendChoice;
-use crate::estimator::Estimator;
-use crate::optics::dots::Placement;
-use crate::optimize::layout::{ObjectiveSpec, VarySpec};
-use crate::optimize::{Method, OptimizeOptions};
+use super::enums;
+use blutrace::accel::BackendChoice;
+use blutrace::estimator::Estimator;
+use blutrace::optics::dots::Placement;
+use blutrace::optimize::layout::{ObjectiveSpec, VarySpec};
+use blutrace::optimize::{Method, OptimizeOptions};
 
 /// How to optimize, as flags.
 #[derive(Clone, Debug, clap::Args)]
 pub struct OptimizeFlags {
     /// Nelder-Mead over the density polynomial (the paper's), or per-strip feedback; with
     /// --vary: Nelder-Mead over the variables, or a grid scan of one or two.
-    #[arg(long, value_enum, default_value = "nelder-mead")]
+    #[arg(long, value_parser = enums::method(), default_value = "nelder-mead")]
     method: Method,
     /// A number of the scene file to optimize, KEY=MIN..MAX (repeatable): KEY a dotted path
     /// such as sources.0.center.2, `*` for every element of an array (set together).
@@ -27,40 +28,40 @@ pub struct OptimizeFlags {
     #[arg(long, default_value_t = 7)]
     grid_points: usize,
     /// Photons per evaluated design.
-    #[arg(long, default_value_t = 1_000_000, value_parser = crate::count::parse_photons)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = blutrace::count::parse_photons)]
     photons: u64,
     /// Iteration cap (Nelder-Mead steps, or feedback rounds after the first trace);
     /// default 60 for Nelder-Mead, 15 for feedback.
     #[arg(long)]
     max_iter: Option<usize>,
     /// Stop once the objective (cv of the profile along the axis) is at or below this.
-    #[arg(long, value_parser = crate::count::parse_finite)]
+    #[arg(long, value_parser = blutrace::count::parse_finite)]
     target_cv: Option<f64>,
     /// Degree of the density polynomial (default: the scene's, at least 3).
     #[arg(long)]
     degree: Option<usize>,
     /// Smallest printable density (area fraction).
-    #[arg(long, default_value_t = 0.01, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 0.01, value_parser = blutrace::count::parse_finite)]
     min_density: f64,
     /// Largest density (default and at most: the lattice's packing limit).
-    #[arg(long, value_parser = crate::count::parse_finite)]
+    #[arg(long, value_parser = blutrace::count::parse_finite)]
     max_density: Option<f64>,
     /// The dots surface to optimize (default: the scene's only one).
     #[arg(long)]
     tag: Option<String>,
     /// Nelder-Mead: initial simplex step (density units at the far end; with --vary, a
     /// fraction of each variable's range).
-    #[arg(long, default_value_t = 0.2, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 0.2, value_parser = blutrace::count::parse_finite)]
     initial_step: f64,
     /// Nelder-Mead: stop once the simplex is smaller than this (density units; with --vary,
     /// a fraction of each variable's range).
-    #[arg(long, default_value_t = 2e-3, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 2e-3, value_parser = blutrace::count::parse_finite)]
     simplex_tol: f64,
     /// Feedback: damping exponent of d <- d (target / measured)^alpha.
-    #[arg(long, default_value_t = 0.7, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 0.7, value_parser = blutrace::count::parse_finite)]
     alpha: f64,
     /// Feedback: weight of the neighbours' mean in a smoothing pass (0: none).
-    #[arg(long, default_value_t = 0.25, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 0.25, value_parser = blutrace::count::parse_finite)]
     smoothing: f64,
     /// Feedback: 1 (a table of knots along the axis) or 2 (a grid over the face, for
     /// non-uniformity across the axis too, such as LEDs on an edge).
@@ -74,11 +75,11 @@ pub struct OptimizeFlags {
     #[arg(long)]
     strips: Option<usize>,
     /// Leave this many mm at either end of the span out of the objective.
-    #[arg(long, default_value_t = 0.0, value_parser = crate::count::parse_finite)]
+    #[arg(long, default_value_t = 0.0, value_parser = blutrace::count::parse_finite)]
     edge_margin_mm: f64,
     /// Photons of the verification re-traces of the first and final design (0: none; the
     /// optimization's own traces of the first and best design are reported instead).
-    #[arg(long, default_value_t = 10_000_000, value_parser = crate::count::parse_count)]
+    #[arg(long, default_value_t = 10_000_000, value_parser = blutrace::count::parse_count)]
     verify_photons: u64,
     /// Seed of the verification re-traces (default: one no evaluation used).
     #[arg(long)]
@@ -87,10 +88,10 @@ pub struct OptimizeFlags {
     #[arg(long)]
     threads: Option<usize>,
     /// Intersection backend.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = enums::backend(), default_value = "auto")]
     backend: BackendChoice,
     /// Analog roulette or absorption by weights.
-    #[arg(long, value_enum, default_value = "analog")]
+    #[arg(long, value_parser = enums::estimator(), default_value = "analog")]
     estimator: Estimator,
     /// For a `placement = "virtual"` surface, which is not printable: write the dot files
     /// for this printable placement of the same density (lattice, jittered or stochastic,
@@ -111,7 +112,7 @@ impl OptimizeFlags {
             grid_points: f.grid_points,
             photons: f.photons,
             seed,
-            interrupt: crate::run::Interrupt::default(),
+            interrupt: blutrace::run::Interrupt::default(),
             max_iter: f.max_iter.unwrap_or(f.method.default_max_iter()),
             target_cv: f.target_cv,
             degree: f.degree,

@@ -1,14 +1,15 @@
 //! `blutrace trace` and `blutrace merge`: run a scene (or one shard of it), merge shards,
 //! and print the run's report.
 
+use super::enums;
 use super::{default_out, scene_path, word};
-use crate::accel::BackendChoice;
-use crate::estimator::Estimator;
-use crate::output::atomic::{check_apart, check_dest};
-use crate::run::{self, Progress, RunOptions, Shard, StoppedBy, TargetMetric};
-use crate::scene::Scene;
-use crate::shard;
 use anyhow::Result;
+use blutrace::accel::BackendChoice;
+use blutrace::estimator::Estimator;
+use blutrace::output::atomic::{check_apart, check_dest};
+use blutrace::run::{self, Progress, RunOptions, Shard, StoppedBy, TargetMetric};
+use blutrace::scene::Scene;
+use blutrace::shard;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -20,19 +21,19 @@ pub(super) struct TraceArgs {
     scene: PathBuf,
     /// Photons to emit at most (default: the scene's [trace] photons, or 1e9 with
     /// --target-error or --max-time).
-    #[arg(long, visible_alias = "max-photons", value_parser = crate::count::parse_photons)]
+    #[arg(long, visible_alias = "max-photons", value_parser = blutrace::count::parse_photons)]
     photons: Option<u64>,
     /// Stop when the relative standard error of --target-metric is at or below this.
-    #[arg(long, value_parser = crate::count::parse_finite)]
+    #[arg(long, value_parser = blutrace::count::parse_finite)]
     target_error: Option<f64>,
     /// The metric --target-error refers to.
-    #[arg(long, value_enum, default_value = "mean")]
+    #[arg(long, value_parser = enums::target_metric(), default_value = "mean")]
     target_metric: TargetMetric,
     /// Stop after about this many seconds of tracing.
-    #[arg(long, value_parser = crate::count::parse_finite)]
+    #[arg(long, value_parser = blutrace::count::parse_finite)]
     max_time: Option<f64>,
     /// Analog roulette (the paper's) or absorption by weights.
-    #[arg(long, value_enum, default_value = "analog")]
+    #[arg(long, value_parser = enums::estimator(), default_value = "analog")]
     estimator: Estimator,
     /// Seed of the per-photon random streams (default: the scene's [trace] seed).
     #[arg(long)]
@@ -41,7 +42,7 @@ pub(super) struct TraceArgs {
     #[arg(long)]
     threads: Option<usize>,
     /// Intersection backend.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = enums::backend(), default_value = "auto")]
     backend: BackendChoice,
     /// Output folder (default: out/<scene name>).
     #[arg(long)]
@@ -291,7 +292,7 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         u.thirteen_point_min_over_max,
         err(e.thirteen_point_min_over_max, 3, false)
     );
-    let chunk = crate::tracer::CHUNK;
+    let chunk = blutrace::tracer::CHUNK;
     if l.detected_w == 0.0 {
         say!(
             "note       no photon reached the target: the map and its uniformity metrics are empty"

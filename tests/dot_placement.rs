@@ -410,7 +410,7 @@ fn optimize_exports_virtual_dots_only_as_a_printable_placement() {
     let lattice = support::load(&small_plate("opt-lattice", ""));
     let e = format!("{:#}", optimize(&lattice, &asked, &mut |_| {}).unwrap_err());
     assert!(
-        e.contains("--export-placement is for virtual patterns"),
+        e.contains("option `export_placement` is for virtual patterns"),
         "{e}"
     );
     // And the command line refuses virtual as an export placement, saying why.

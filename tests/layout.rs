@@ -202,7 +202,7 @@ fn bad_variables_are_refused() {
         (
             vec!["sources.5.center.0=0..1"],
             Method::NelderMead,
-            "--vary sources.5.center.0: sources has 2 elements",
+            "option `vary` sources.5.center.0: sources has 2 elements",
         ),
         (
             vec!["sources.0.name=0..1"],
@@ -236,7 +236,7 @@ fn bad_variables_are_refused() {
         (
             vec!["sources.0.center.0=-40..0"],
             Method::Feedback,
-            "--method feedback",
+            "option `method` feedback",
         ),
     ] {
         let o = options(&vary, method);
@@ -252,7 +252,7 @@ fn bad_variables_are_refused() {
         "{:#}",
         optimize_layout(&scene, &o, &mut |_, _| {}).unwrap_err()
     );
-    assert!(e.contains("--degree"), "{e}");
+    assert!(e.contains("option `degree`"), "{e}");
 }
 
 /// A design whose scene does not load gets the penalty and its reason, and is not traced.

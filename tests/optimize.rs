@@ -476,7 +476,7 @@ fn options_of_one_method_are_refused_by_the_other() {
                 dims: 2,
                 ..base.clone()
             },
-            "--dims 2 needs --method feedback",
+            "option `dims` 2 needs option `method` feedback",
         ),
         (
             OptimizeOptions {
@@ -484,7 +484,7 @@ fn options_of_one_method_are_refused_by_the_other() {
                 dims: 3,
                 ..base.clone()
             },
-            "--dims must be 1 or 2",
+            "option `dims` must be 1 or 2",
         ),
         (
             OptimizeOptions {
@@ -492,7 +492,7 @@ fn options_of_one_method_are_refused_by_the_other() {
                 cells: Some((4, 4)),
                 ..base.clone()
             },
-            "--cells needs --method feedback --dims 2",
+            "option `cells` needs option `method` feedback option `dims` 2",
         ),
         (
             OptimizeOptions {
@@ -501,7 +501,7 @@ fn options_of_one_method_are_refused_by_the_other() {
                 cells: Some((1, 4)),
                 ..base.clone()
             },
-            "--cells needs at least 2 knots each way",
+            "option `cells` needs at least 2 knots each way",
         ),
     ] {
         let err = optimize(&scene, &options, &mut |_| {}).err();

@@ -93,7 +93,7 @@ pub fn main() -> ExitCode {
         }
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", as_flags(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }
@@ -111,6 +111,35 @@ fn command() -> clap::Command {
         .mut_subcommands(negatives)
     }
     negatives(Cli::command())
+}
+
+/// A library message with its options named as flags: the library writes "option
+/// `max_time`" (the field of its options), the command line reads `--max-time`.
+fn as_flags(msg: &str) -> String {
+    const MARK: &str = "option `";
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg;
+    while let Some(i) = rest.find(MARK) {
+        let after = &rest[i + MARK.len()..];
+        match after.find('`') {
+            Some(j)
+                if after[..j]
+                    .bytes()
+                    .all(|b| b.is_ascii_lowercase() || b == b'_') =>
+            {
+                out.push_str(&rest[..i]);
+                out.push_str("--");
+                out.push_str(&after[..j].replace('_', "-"));
+                rest = &after[j + 1..];
+            }
+            _ => {
+                out.push_str(&rest[..i + MARK.len()]);
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Set once a line could not be written to stdout (its reader is gone).
@@ -218,7 +247,7 @@ pub(crate) fn default_out(name: &str) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
-    use super::default_out;
+    use super::{as_flags, default_out};
     use std::path::PathBuf;
 
     #[test]
@@ -238,5 +267,18 @@ mod tests {
                 "{name:?}"
             );
         }
+    }
+
+    #[test]
+    fn library_options_read_as_flags() {
+        assert_eq!(
+            as_flags("option `max_time` must be > 0; option `vary` a.b: no key"),
+            "--max-time must be > 0; --vary a.b: no key"
+        );
+        // Anything else in backticks is left alone.
+        assert_eq!(
+            as_flags("a `usemtl` name, option `Bad`"),
+            "a `usemtl` name, option `Bad`"
+        );
     }
 }

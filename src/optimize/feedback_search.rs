@@ -45,7 +45,7 @@ pub(super) fn run_feedback(
             };
             feedback_rounds(search, &mut grid, "feedback-2d", "area cv", progress)
         }
-        d => bail!("--dims must be 1 or 2, got {d}"),
+        d => bail!("option `dims` must be 1 or 2, got {d}"),
     }
 }
 
@@ -181,11 +181,14 @@ fn feedback_settings(search: &Search) -> Result<feedback::Settings> {
         max: search.max,
     };
     if !(settings.alpha > 0.0 && settings.alpha <= 2.0) {
-        bail!("--alpha must be within (0, 2], got {}", settings.alpha);
+        bail!(
+            "option `alpha` must be within (0, 2], got {}",
+            settings.alpha
+        );
     }
     if !(0.0..=1.0).contains(&settings.smoothing) {
         bail!(
-            "--smoothing must be within [0, 1], got {}",
+            "option `smoothing` must be within [0, 1], got {}",
             settings.smoothing
         );
     }

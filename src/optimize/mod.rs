@@ -87,7 +87,7 @@ pub fn optimize(
 ) -> Result<OptimizeResult> {
     check_method_options(options)?;
     if !options.vary.is_empty() {
-        bail!("--vary variables are optimized by optimize_layout");
+        bail!("option `vary` variables are optimized by optimize_layout");
     }
     let mut search = Search::new(scene, options)?;
     let tag = scene.tags[search.tag_id].clone();
@@ -96,7 +96,7 @@ pub fn optimize(
     let searched = match options.method {
         Method::NelderMead => run_nelder_mead(&mut search, progress),
         Method::Feedback => run_feedback(&mut search, progress),
-        Method::Grid => bail!("--method grid needs --vary"),
+        Method::Grid => bail!("option `method` grid needs option `vary`"),
     };
     let mut interrupted = false;
     let termination = match searched {

@@ -175,7 +175,7 @@ pub(super) fn export_placement(
     match (traced.printable(), options.export_placement) {
         (true, None) => Ok(Some(traced)),
         (true, Some(_)) => bail!(
-            "--export-placement is for virtual patterns: surfaces.{tag} is printed as \"{}\", and its dots are exported as traced",
+            "option `export_placement` is for virtual patterns: surfaces.{tag} is printed as \"{}\", and its dots are exported as traced",
             traced.name()
         ),
         (false, asked) => Ok(asked),
@@ -185,18 +185,24 @@ pub(super) fn export_placement(
 /// Options that only one method takes must not be given to the other.
 pub(super) fn check_method_options(options: &OptimizeOptions) -> Result<()> {
     if options.vary.is_empty() && options.method == Method::Grid {
-        bail!("--method grid scans --vary variables: give at least one --vary KEY=MIN..MAX");
+        bail!(
+            "option `method` grid scans option `vary` variables: give at least one option `vary` KEY=MIN..MAX"
+        );
     }
     if !(1..=2).contains(&options.dims) {
-        bail!("--dims must be 1 or 2, got {}", options.dims);
+        bail!("option `dims` must be 1 or 2, got {}", options.dims);
     }
     if options.dims == 2 && !options.tunes_grid() {
-        bail!("--dims 2 needs --method feedback (Nelder-Mead tunes a polynomial along the axis)");
+        bail!(
+            "option `dims` 2 needs option `method` feedback (Nelder-Mead tunes a polynomial along the axis)"
+        );
     }
     match options.cells {
-        Some(_) if !options.tunes_grid() => bail!("--cells needs --method feedback --dims 2"),
+        Some(_) if !options.tunes_grid() => {
+            bail!("option `cells` needs option `method` feedback option `dims` 2")
+        }
         Some((nx, ny)) if nx < 2 || ny < 2 => {
-            bail!("--cells needs at least 2 knots each way, got {nx},{ny}")
+            bail!("option `cells` needs at least 2 knots each way, got {nx},{ny}")
         }
         _ => Ok(()),
     }

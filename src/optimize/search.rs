@@ -49,7 +49,7 @@ fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
                 scene.path.display()
             ),
             _ => bail!(
-                "{}: several dots surfaces ({}): pick one with --tag",
+                "{}: several dots surfaces ({}): pick one with option `tag`",
                 scene.path.display(),
                 names()
             ),
@@ -96,7 +96,9 @@ fn density_range(options: &OptimizeOptions, pattern: &DotPattern) -> Result<(f64
     let max = options.max_density.unwrap_or(packing).min(packing);
     let min = options.min_density;
     if !(min.is_finite() && min >= 0.0 && min < max) {
-        bail!("--min-density {min} must be within [0, {max:.4}) (the largest density allowed)");
+        bail!(
+            "option `min_density` {min} must be within [0, {max:.4}) (the largest density allowed)"
+        );
     }
     Ok((min, max))
 }
@@ -104,7 +106,7 @@ fn density_range(options: &OptimizeOptions, pattern: &DotPattern) -> Result<(f64
 /// The profile strips; checks them with `--photons` and `--edge-margin-mm`.
 fn checked_strips(scene: &Scene, options: &OptimizeOptions, pattern: &DotPattern) -> Result<usize> {
     if options.photons == 0 {
-        bail!("--photons must be at least 1");
+        bail!("option `photons` must be at least 1");
     }
     let strips = options
         .strips
@@ -114,7 +116,7 @@ fn checked_strips(scene: &Scene, options: &OptimizeOptions, pattern: &DotPattern
     }
     if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.length) {
         bail!(
-            "--edge-margin-mm {} must be >= 0 and leave part of the {:.1} mm span",
+            "option `edge_margin_mm` {} must be >= 0 and leave part of the {:.1} mm span",
             options.edge_margin_mm,
             pattern.length
         );

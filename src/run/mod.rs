@@ -124,17 +124,17 @@ impl Shard {
     pub fn parse(s: &str) -> Result<Shard> {
         let (k, m) = s
             .split_once('/')
-            .with_context(|| format!("--shard {s}: expected K/M, e.g. 0/4"))?;
+            .with_context(|| format!("'{s}': expected K/M, e.g. 0/4"))?;
         let (index, count): (u64, u64) = (
             k.trim()
                 .parse()
-                .with_context(|| format!("--shard {s}: K is not a number"))?,
+                .with_context(|| format!("'{s}': K is not a number"))?,
             m.trim()
                 .parse()
-                .with_context(|| format!("--shard {s}: M is not a number"))?,
+                .with_context(|| format!("'{s}': M is not a number"))?,
         );
         if count == 0 || index >= count || count > MAX_SHARDS {
-            bail!("--shard {s}: need 0 <= K < M <= {MAX_SHARDS}");
+            bail!("'{s}': need 0 <= K < M <= {MAX_SHARDS}");
         }
         Ok(Shard { index, count })
     }
@@ -344,20 +344,20 @@ pub fn trace_reusing(
     if let Some(e) = options.target_error
         && !(e > 0.0 && e.is_finite())
     {
-        bail!("--target-error must be a positive number, got {e}");
+        bail!("option `target_error` must be a positive number, got {e}");
     }
     if let Some(t) = options.max_time_s
         && !(t > 0.0 && t.is_finite())
     {
-        bail!("--max-time must be a finite number of seconds > 0, got {t}");
+        bail!("option `max_time` must be a finite number of seconds > 0, got {t}");
     }
     if options.photons == 0 {
-        bail!("--photons must be at least 1: a run of no photons has nothing to report");
+        bail!("option `photons` must be at least 1: a run of no photons has nothing to report");
     }
     if let Some(n) = options.threads
         && !(1..=MAX_THREADS).contains(&n)
     {
-        bail!("--threads must be within 1..={MAX_THREADS}, got {n}");
+        bail!("option `threads` must be within 1..={MAX_THREADS}, got {n}");
     }
     check_tally_budget(scene)?;
     if options.target_error.is_some()
@@ -366,12 +366,14 @@ pub fn trace_reusing(
     {
         bail!(
             "{}: detector.bins is [1, 1]: the cv of a one-bin map is 0 by construction, so \
-             --target-metric cv can never reach a relative error",
+             option `target_metric` cv can never reach a relative error",
             scene.path.display()
         );
     }
     if options.shard.is_some() && (options.target_error.is_some() || options.max_time_s.is_some()) {
-        bail!("a shard traces a fixed photon range: --target-error and --max-time do not apply");
+        bail!(
+            "a shard traces a fixed photon range: option `target_error` and option `max_time` do not apply"
+        );
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads.unwrap_or(0))

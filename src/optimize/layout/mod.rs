@@ -58,7 +58,7 @@ pub fn optimize_layout(
     let vars = resolve_variables(&doc, options)?;
     check_method(options, &vars)?;
     if options.photons == 0 {
-        bail!("--photons must be at least 1");
+        bail!("option `photons` must be at least 1");
     }
     let mut search = LayoutSearch {
         scene,
@@ -116,14 +116,14 @@ fn resolve_variables(doc: &Value, options: &OptimizeOptions) -> Result<Vec<Varia
     for (i, v) in vars.iter().enumerate() {
         if let Some(w) = vars[..i].iter().find(|w| w.overlaps(v)) {
             bail!(
-                "--vary {} and --vary {} set the same number",
+                "option `vary` {} and option `vary` {} set the same number",
                 w.name,
                 v.name
             );
         }
         if !v.integer && !(v.min..=v.max).contains(&v.initial) {
             bail!(
-                "--vary {}: the scene's value {} is outside {}..{} (the search starts from the scene's design)",
+                "option `vary` {}: the scene's value {} is outside {}..{} (the search starts from the scene's design)",
                 v.name,
                 v.initial,
                 v.min,
@@ -138,31 +138,33 @@ fn resolve_variables(doc: &Value, options: &OptimizeOptions) -> Result<Vec<Varia
 fn check_method(options: &OptimizeOptions, vars: &[Variable]) -> Result<()> {
     let o = options;
     for (given, flag) in [
-        (o.tag.is_some(), "--tag"),
-        (o.degree.is_some(), "--degree"),
-        (o.strips.is_some(), "--strips"),
-        (o.cells.is_some(), "--cells"),
-        (o.max_density.is_some(), "--max-density"),
-        (o.target_cv.is_some(), "--target-cv"),
-        (o.dims != 1, "--dims"),
+        (o.tag.is_some(), "option `tag`"),
+        (o.degree.is_some(), "option `degree`"),
+        (o.strips.is_some(), "option `strips`"),
+        (o.cells.is_some(), "option `cells`"),
+        (o.max_density.is_some(), "option `max_density`"),
+        (o.target_cv.is_some(), "option `target_cv`"),
+        (o.dims != 1, "option `dims`"),
     ] {
         if given {
             bail!(
-                "{flag} is an option of the dot-density search, not of --vary (vary the density's keys instead)"
+                "{flag} is an option of the dot-density search, not of option `vary` (vary the density's keys instead)"
             );
         }
     }
     let continuous = vars.iter().filter(|v| !v.integer).count();
     match options.method {
         Method::Feedback => {
-            bail!("--method feedback tunes dot densities; with --vary use nelder-mead or grid")
+            bail!(
+                "option `method` feedback tunes dot densities; with option `vary` use nelder-mead or grid"
+            )
         }
         Method::Grid if !(1..=2).contains(&continuous) => {
-            bail!("--method grid scans one or two continuous variables, got {continuous}")
+            bail!("option `method` grid scans one or two continuous variables, got {continuous}")
         }
         Method::Grid if options.grid_points < 2 => {
             bail!(
-                "--grid-points must be at least 2, got {}",
+                "option `grid_points` must be at least 2, got {}",
                 options.grid_points
             )
         }

@@ -91,11 +91,11 @@ impl Variable {
         let key = &spec.key;
         if key.split('.').next() == Some("trace") {
             bail!(
-                "--vary {key}: [trace] holds how a run is traced (photons, seed, max_bounces), \
-                 which the search sets itself (--photons, --seed); vary a number of the design"
+                "option `vary` {key}: [trace] holds how a run is traced (photons, seed, max_bounces), \
+                 which the search sets itself (option `photons`, option `seed`); vary a number of the design"
             );
         }
-        let places = key_path::resolve(doc, key).with_context(|| format!("--vary {key}"))?;
+        let places = key_path::resolve(doc, key).with_context(|| format!("option `vary` {key}"))?;
         let values: Vec<&Value> = places.iter().map(|p| get(doc, p)).collect();
         let numbers: Vec<f64> = values
             .iter()
@@ -103,13 +103,17 @@ impl Variable {
             .map(|(v, p)| match v {
                 Value::Integer(i) => Ok(*i as f64),
                 Value::Float(x) => Ok(*x),
-                other => bail!("--vary {key}: {} is {}, not a number", show(p), kind(other)),
+                other => bail!(
+                    "option `vary` {key}: {} is {}, not a number",
+                    show(p),
+                    kind(other)
+                ),
             })
             .collect::<Result<_>>()?;
         let initial = numbers[0];
         if let Some(i) = numbers.iter().position(|x| *x != initial) {
             bail!(
-                "--vary {key}: the elements differ ({} = {initial}, {} = {}); a `*` variable \
+                "option `vary` {key}: the elements differ ({} = {initial}, {} = {}); a `*` variable \
                  sets them all to one value",
                 show(&places[0]),
                 show(&places[i]),
@@ -119,7 +123,7 @@ impl Variable {
         let integer = values.iter().all(|v| v.is_integer()) && !accepts_float(doc, &places);
         if integer && spec.min.ceil() > spec.max.floor() {
             bail!(
-                "--vary {key}: an integer field, and {}..{} holds no integer",
+                "option `vary` {key}: an integer field, and {}..{} holds no integer",
                 spec.min,
                 spec.max
             );
@@ -299,7 +303,7 @@ bins = [10, 10]
             let e = format!("{:#}", Variable::resolve(&d, &spec(key)).unwrap_err());
             let k = key.split('=').next().unwrap();
             assert!(
-                e.contains(&format!("--vary {k}")) && e.contains(says),
+                e.contains(&format!("option `vary` {k}")) && e.contains(says),
                 "{key}: {e}"
             );
         }

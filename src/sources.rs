@@ -130,6 +130,18 @@ impl SourceSpec {
         }
     }
 
+    /// The files the source reads, relative to the scene file (its measured intensity
+    /// table): the content hash covers their bytes, as it does surface models' tables.
+    pub fn files(&self) -> Vec<PathBuf> {
+        match self {
+            SourceSpec::Led {
+                intensity_file: Some(f),
+                ..
+            } => vec![f.clone()],
+            _ => Vec::new(),
+        }
+    }
+
     /// Check entry `i` of `[[sources]]` and build the source (a measured LED's
     /// `intensity_file` is relative to the scene file).
     pub fn build(&self, ctx: &Ctx, i: usize, media: &[Medium]) -> Result<Source> {

@@ -3,8 +3,8 @@
 //! It covers everything that decides the physics, in canonical form: the scene file's
 //! geometry, media, surfaces, sources, detector and bounce cap as serde JSON of the typed
 //! [`SceneFile`] (fixed field order, sorted maps, shortest round-trip floats), the bytes
-//! of the measured tables it names (the sources' intensity files, and every file a
-//! surface model declares, [`crate::optics::surface::SurfaceSpecOf::files`]), and the loaded mesh (vertex coordinates,
+//! of the measured tables it names (every file a surface model or a source declares:
+//! [`crate::optics::surface::SurfaceSpecOf::files`], [`SourceSpec::files`]), and the loaded mesh (vertex coordinates,
 //! triangles and tags as little-endian bytes). Not the name, description or the default
 //! photon count and seed.
 
@@ -39,20 +39,12 @@ pub(super) fn file_hash(file: &SceneFile, path: &Path) -> Result<u64> {
     let mut h = Fnv1a::default();
     h.write(&serde_json::to_vec(&physics)?);
     let dir = path.parent().unwrap_or(Path::new("."));
-    for f in file.surfaces.values().flat_map(|s| s.files()) {
-        let bytes = crate::input_file::read_bytes(&dir.join(f), "surface table")?;
-        h.write(&bytes);
-    }
-    for s in &file.sources {
-        if let SourceSpec::Led {
-            intensity_file: Some(f),
-            ..
-        } = s
-        {
-            let table = dir.join(f);
-            let bytes = crate::input_file::read_bytes(&table, "intensity file")?;
-            h.write(&bytes);
-        }
+    let tables = file.surfaces.values().flat_map(|s| s.files());
+    for f in tables.chain(file.sources.iter().flat_map(|s| s.files())) {
+        h.write(&crate::input_file::read_bytes(
+            &dir.join(f),
+            "measured table",
+        )?);
     }
     Ok(h.0)
 }

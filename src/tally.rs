@@ -430,19 +430,12 @@ impl Ledger {
             .try_fold(ExactSum(0), |s, a| s.checked_add(*a))
     }
 
-    /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances).
+    /// Sum of all fates' weights (equals `emitted` exactly when the ledger balances), of
+    /// a ledger a run scored: its sinks stay far inside the `i128` range (a ledger read
+    /// from a file goes through [`Ledger::checked_accounted`] instead).
     pub fn accounted(&self) -> ExactSum {
-        let mut s =
-            ExactSum(self.detected.sum.0 + self.escaped.0 + self.killed.0 + self.roulette.0);
-        for a in self
-            .absorbed_by_surface
-            .iter()
-            .chain(&self.absorbed_in_medium)
-            .chain(&self.absorbed_by_source)
-        {
-            s.merge(*a);
-        }
-        s
+        self.checked_accounted()
+            .expect("a traced run's ledger sums within i128")
     }
 }
 

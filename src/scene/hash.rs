@@ -4,8 +4,8 @@
 //! geometry, media, surfaces, sources, detector and bounce cap as serde JSON of the typed
 //! [`SceneFile`] (fixed field order, sorted maps, shortest round-trip floats), the bytes
 //! of the measured tables it names (every file a surface model or a source declares:
-//! [`crate::optics::surface::SurfaceSpecOf::files`], [`SourceSpec::files`]), and the loaded mesh (vertex coordinates,
-//! triangles and tags as little-endian bytes). Not the name, description or the default
+//! [`crate::optics::surface::SurfaceSpecOf::files`], [`SourceSpec::files`]), and the
+//! loaded mesh (vertex coordinates, triangles and tags as little-endian bytes). Not the name, description or the default
 //! photon count and seed.
 
 use super::config::{GeometrySpec, MediumSpec, SceneFile, SourceSpec, SurfaceSpec};

@@ -128,7 +128,7 @@ fn grid_by_hand(u: f64, v: f64) -> f64 {
 #[test]
 fn density_grid_is_bilinear_at_cell_centres_and_covers_its_area_fraction() {
     let p = grid_pattern();
-    assert_eq!(p.density.problem(), None);
+    assert_eq!(p.grade.density.problem(), None);
     assert_eq!(p.first_out_of_range(), None);
     // Every exported dot is sized by the bilinear density at its own cell centre.
     let dots = export::dots_on_face(&p, &rectangle()).unwrap();

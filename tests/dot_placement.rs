@@ -227,7 +227,7 @@ fn exports_refuse_a_pitch_that_would_print_billions_of_dots() {
     );
     // At the cap's own scale it still exports (0.1 mm pitch: 3e6 cells on this face).
     fine.pitch = 0.1;
-    fine.density = Density::Polynomial(vec![0.0]);
+    fine.grade.density = Density::Polynomial(vec![0.0]);
     assert!(export::dots_on_face(&fine, &face).unwrap().is_empty());
 }
 

@@ -203,7 +203,9 @@ fn density_grid_in_scene_files() {
         "density_grid = { width_mm = 10.0, v_min_mm = -5.0, values = [[0.1, 0.2], [0.3, 0.4]] }",
     ));
     let dots = dots_of(&grid);
-    assert!(matches!(&dots.density, Density::Grid(g) if g.x_max == 1.0 && g.shape() == (2, 2)));
+    assert!(
+        matches!(&dots.grade.density, Density::Grid(g) if g.x_max == 1.0 && g.shape() == (2, 2))
+    );
     // Mid-span, mid-width: the mean of the four knots.
     assert!((dots.density_at_point(DVec2::new(20.0, 0.0)) - 0.25).abs() < 1e-12);
     for (name, text, words) in [
@@ -334,7 +336,7 @@ fn optimizers_improve_a_small_scene_and_write_a_traceable_result() {
         assert_eq!(history.lines().count(), r.history.len() + 1);
         let again = Scene::load(&out.join("optimized.toml")).unwrap();
         let d = dots_of(&again);
-        assert_eq!(d.density, r.final_density);
+        assert_eq!(d.grade.density, r.final_density);
         let csv = std::fs::read_to_string(out.join("dots.csv")).unwrap();
         assert_eq!(export::parse_csv(&csv).unwrap().len(), dots.len());
     }
@@ -576,7 +578,7 @@ fn feedback_2d_beats_1d_on_phone_led() {
     assert!(out.join("density_map.png").is_file());
     let again = load(&out.join("optimized.toml"));
     let reloaded = dots_of(&again);
-    assert_eq!(reloaded.density, two.final_density);
+    assert_eq!(reloaded.grade.density, two.final_density);
 }
 
 /// An interrupt during a search keeps the designs fully traced before it: the design

@@ -407,7 +407,7 @@ fn bad_groove_and_diffuser_parameters_are_named() {
             grooves(
                 "apex_deg = 100.0\npitch_mm = 0.2\ndensity = [0.1]\ndensity_table = [[0.0, 0.1]]\n",
             ),
-            "surfaces.back.density: give either",
+            "surfaces.back.density: give only one of",
         ),
         (
             grooves("apex_deg = 100.0\npitch_mm = 0.2\ndensity_table = [[0.0, 0.1], [0.0, 0.2]]\n"),

@@ -28,7 +28,7 @@
 //! origin): `f32` keeps positions to a few nanometres there, far below the dot sizes.
 
 use crate::geometry::Aabb;
-use crate::optics::density::{Density, graded_x};
+use crate::optics::density::Density;
 use crate::optics::dots::{Lattice, Placement};
 use crate::optics::lambert::Lambert;
 use crate::optics::surface::SurfaceModel;
@@ -346,7 +346,7 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
             "dots must be on a square lattice at the cell centres (placement \"lattice\")"
         ));
     }
-    let Density::Polynomial(coeffs) = &pattern.density else {
+    let Density::Polynomial(coeffs) = &pattern.grade.density else {
         bail!(refuse(scene, "the dot density must be a polynomial"));
     };
     // The columns (cells along the axis) the face spans, one more each side.
@@ -376,7 +376,7 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
     let r2 = (lo_col..=hi_col)
         .map(|i| {
             let u = (f64::from(i) + 0.5) * p;
-            let x = graded_x(u, pattern.length, pattern.x_unit, pattern.mirror);
+            let x = pattern.x_of(u);
             let d = coeffs.iter().rev().fold(0.0, |acc, c| acc * x + c);
             (d.max(0.0) * p * p / PI) as f32
         })

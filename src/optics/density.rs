@@ -108,7 +108,12 @@ pub enum XUnit {
 }
 
 /// The density function d(x): the area fraction of a cell covered by its dot.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// The same value from the scene file (see [`Density::from_keys`]) through the optimizer
+/// (which writes it back with [`Density::keys`]) to `result.json`, where it serializes
+/// as `{"polynomial": [...]}`, `{"table": [[x, d], ...]}` or `{"grid": {...}}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Density {
     /// Polynomial coefficients, lowest degree first: `d(x) = c0 + c1 x + c2 x^2 + ...`.
     Polynomial(Vec<f64>),
@@ -120,42 +125,125 @@ pub enum Density {
 }
 
 /// A density on a regular grid of knots: along the axis in the polynomial variable
-/// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`).
-#[derive(Clone, Debug, PartialEq)]
+/// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`). In a scene file,
+/// `density_grid = { width_mm = W, v_min_mm = V, values = [[...], ...] }`: rows across
+/// the axis, columns along it; `x_max` follows from the pattern (see [`graded_x_max`]).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
 pub struct DensityGrid {
-    /// The polynomial variable at the last column of knots.
+    /// The polynomial variable at the last column of knots (set when the pattern is
+    /// built: not a key of the file).
+    #[serde(skip)]
     pub x_max: f64,
     /// Position across the axis (mm from the origin along `across`) of the first row.
+    #[serde(rename = "v_min_mm", default)]
     pub v_min: f64,
     /// Span across the axis (mm) from the first to the last row.
+    #[serde(rename = "width_mm")]
     pub width: f64,
     /// `values[j][i]`: row `j` across the axis, column `i` along it.
     pub values: Vec<Vec<f64>>,
 }
 
-/// `density_grid = { width_mm = W, values = [[...], ...] }` of a dots surface: rows across
-/// the axis (`v_min_mm ..= v_min_mm + width_mm`), columns along it (`x` over `0..=x_max`).
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct DensityGridSpec {
-    /// Span across the axis from the first to the last row (mm).
-    pub width_mm: f64,
-    /// Position of the first row across the axis (mm from the origin along `across`).
-    #[serde(default)]
-    pub v_min_mm: f64,
-    /// `values[j][i]`: row `j` across the axis, column `i` along it.
-    pub values: Vec<Vec<f64>>,
+/// The scene-file keys a density is given by (exactly one of them): `density`
+/// (polynomial), `density_table` (knots) or `density_grid` (dots only).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DensityKeys {
+    /// `density`: polynomial coefficients.
+    pub density: Option<Vec<f64>>,
+    /// `density_table`: `[x, d]` knots.
+    pub density_table: Option<Vec<[f64; 2]>>,
+    /// `density_grid`: knots over the face.
+    pub density_grid: Option<DensityGrid>,
 }
 
-impl DensityGridSpec {
-    /// The grid, its last column at the polynomial variable `x_max` (see [`graded_x_max`]).
-    pub fn grid(&self, x_max: f64) -> DensityGrid {
-        DensityGrid {
-            x_max,
-            v_min: self.v_min_mm,
-            width: self.width_mm,
-            values: self.values.clone(),
+impl DensityKeys {
+    /// The names of the keys given.
+    fn given(&self) -> Vec<&'static str> {
+        [
+            ("density", self.density.is_some()),
+            ("density_table", self.density_table.is_some()),
+            ("density_grid", self.density_grid.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(k, given)| given.then_some(k))
+        .collect()
+    }
+}
+
+impl Density {
+    /// The density the keys of table `at` give (exactly one of them; `default` when
+    /// none is and the model has one), checked, with the field that gave it. `x_max`
+    /// places a grid's last column (see [`graded_x_max`]).
+    pub fn from_keys(
+        ctx: &Ctx,
+        at: &str,
+        keys: DensityKeys,
+        default: Option<Density>,
+        x_max: f64,
+    ) -> Result<(Density, String)> {
+        let f = |k: &str| format!("{at}.{k}");
+        let (density, field) = match keys {
+            DensityKeys {
+                density: Some(c),
+                density_table: None,
+                density_grid: None,
+            } => (Density::Polynomial(c), f("density")),
+            DensityKeys {
+                density: None,
+                density_table: Some(k),
+                density_grid: None,
+            } => (Density::Table(k), f("density_table")),
+            DensityKeys {
+                density: None,
+                density_table: None,
+                density_grid: Some(g),
+            } => (
+                Density::Grid(Self::placed_grid(ctx, at, g, x_max)?),
+                f("density_grid"),
+            ),
+            DensityKeys {
+                density: None,
+                density_table: None,
+                density_grid: None,
+            } => match default {
+                Some(d) => (d, f("density")),
+                None => {
+                    return Err(ctx.err(
+                        &f("density"),
+                        "missing: give density (polynomial coefficients), density_table ([x, d] knots) or density_grid",
+                    ));
+                }
+            },
+            keys => {
+                let given = keys.given().join(" and ");
+                let msg = format!("give only one of the density keys ({given} are given)");
+                return Err(ctx.err(&f("density"), msg));
+            }
+        };
+        Ok((density.checked(ctx, &field)?, field))
+    }
+
+    /// `g` with its last column at `x_max`, its width checked.
+    fn placed_grid(ctx: &Ctx, at: &str, mut g: DensityGrid, x_max: f64) -> Result<DensityGrid> {
+        let field = format!("{at}.density_grid.width_mm");
+        ctx.non_negative(&field, g.width)?;
+        if g.width > crate::spec_check::MAX_COORDINATE {
+            ctx.length(&field, g.width)?;
         }
+        g.x_max = x_max;
+        Ok(g)
+    }
+
+    /// The scene-file keys that give this density (the inverse of [`Density::from_keys`]).
+    pub fn keys(&self) -> DensityKeys {
+        let mut keys = DensityKeys::default();
+        match self {
+            Density::Polynomial(c) => keys.density = Some(c.clone()),
+            Density::Table(k) => keys.density_table = Some(k.clone()),
+            Density::Grid(g) => keys.density_grid = Some(g.clone()),
+        }
+        keys
     }
 }
 
@@ -389,25 +477,45 @@ impl Gradation {
         self.density.eval(self.x_of(u))
     }
 
-    /// The first position (mm) along the span where the value is not finite or outside
-    /// `[lo, hi]`, with that value: the knots of a grid (bilinear values lie between
-    /// them), else the value sampled finely along the span.
-    pub fn first_outside(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
-        let outside = |v: f64| !v.is_finite() || !(lo..=hi).contains(&v);
+    /// Positions (mm) along the span with the value there, as the range checks see
+    /// them: a grid's knots (bilinear values lie between them), else `samples + 1`
+    /// evenly spaced values (one for a constant).
+    fn span_values(&self, samples: usize) -> Box<dyn Iterator<Item = (f64, f64)> + '_> {
         if let Density::Grid(g) = &self.density {
             let (nx, _) = g.shape();
-            return g.values.iter().flatten().enumerate().find_map(|(k, &d)| {
+            return Box::new(g.values.iter().flatten().enumerate().map(move |(k, &d)| {
                 let i = k % nx.max(1);
                 let u = self.length * i as f64 / (nx - 1).max(1) as f64;
-                let u = if self.mirror { 0.5 * u } else { u };
-                outside(d).then_some((u, d))
-            });
+                (if self.mirror { 0.5 * u } else { u }, d)
+            }));
         }
-        let samples = if self.is_constant() { 0 } else { 4096 };
-        (0..=samples)
-            .map(|i| self.length * i as f64 / samples.max(1) as f64)
-            .map(|u| (u, self.at(u)))
-            .find(|&(_, g)| outside(g))
+        let samples = if self.is_constant() { 0 } else { samples };
+        Box::new(
+            (0..=samples)
+                .map(move |i| self.length * i as f64 / samples.max(1) as f64)
+                .map(|u| (u, self.at(u))),
+        )
+    }
+
+    /// The first position (mm) along the span where the value is not finite or outside
+    /// `[lo, hi]`, with that value (see [`Gradation::span_values`]).
+    pub fn first_outside(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        self.span_values(4096)
+            .find(|&(_, v)| !v.is_finite() || !(lo..=hi).contains(&v))
+    }
+
+    /// How far the value leaves `[lo, hi]` anywhere on the span (0: within; infinite
+    /// where it is not finite), from `samples + 1` values (see [`Gradation::span_values`]).
+    pub fn worst_excess(&self, lo: f64, hi: f64, samples: usize) -> f64 {
+        self.span_values(samples)
+            .map(|(_, v)| {
+                if v.is_finite() {
+                    (lo - v).max(v - hi).max(0.0)
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(0.0, f64::max)
     }
 
     #[cfg(test)]

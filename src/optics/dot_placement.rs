@@ -258,8 +258,8 @@ impl DotPattern {
     /// The column table of this pattern, when it has one: `lattice` placement, a density
     /// along the axis only, at most a million columns.
     pub fn column_radii(&self) -> Option<ColumnRadii> {
-        let along_axis = !matches!(self.density, Density::Grid(_));
-        let columns = self.length / self.pitch;
+        let along_axis = !matches!(self.grade.density, Density::Grid(_));
+        let columns = self.grade.length / self.pitch;
         // (NaN columns do not fit.)
         let fits = columns <= MAX_TABLED_COLUMNS;
         if !(self.placement == Placement::Lattice && along_axis && fits) {
@@ -334,7 +334,7 @@ fn poisson(mean: f64, u: f64) -> u32 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::dots::test_pattern;
+    use super::super::dots::{Gradation, XUnit, test_pattern};
     use super::*;
 
     #[test]
@@ -387,10 +387,12 @@ mod tests {
                 let p = DotPattern {
                     pitch: 0.37,
                     origin: DVec3::new(-3.0, 1.0, 0.0),
-                    length: 41.3,
-                    density,
-                    x_unit,
-                    mirror,
+                    grade: Gradation {
+                        density,
+                        length: 41.3,
+                        x_unit,
+                        mirror,
+                    },
                     ..test_pattern(lattice, 0.0)
                 };
                 let radii = p.column_radii().expect("a lattice graded along its axis");
@@ -424,8 +426,12 @@ mod tests {
         for lattice in [Lattice::Square, Lattice::Hex] {
             let p = DotPattern {
                 pitch: 0.3,
-                length: 50.0,
-                density: Density::Polynomial(vec![0.1, 0.6]),
+                grade: Gradation {
+                    density: Density::Polynomial(vec![0.1, 0.6]),
+                    length: 50.0,
+                    x_unit: XUnit::Normalized,
+                    mirror: false,
+                },
                 ..test_pattern(lattice, 0.0)
             };
             let mut g = PhotonRng::new(1, 2);

@@ -48,8 +48,8 @@
 //! groove fill of [`super::grooves`]; this module owns the lattice and the dot sizes,
 //! [`super::dot_placement`] where the dots sit and whether a hit meets ink.
 
-pub use super::density::{Density, DensityGrid, XUnit};
-use super::density::{DensityGridSpec, Gradation, graded_x, graded_x_max};
+use super::density::graded_x_max;
+pub use super::density::{Density, DensityGrid, DensityKeys, Gradation, XUnit};
 use super::density::{check_pitch, check_span};
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
@@ -94,7 +94,7 @@ pub struct DotsSpec {
     pub density_table: Option<Vec<[f64; 2]>>,
     /// Density on a grid of knots over the face, bilinear (or `density`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub density_grid: Option<DensityGridSpec>,
+    pub density_grid: Option<DensityGrid>,
     /// Unit of the polynomial variable.
     #[serde(default)]
     pub x_unit: XUnit,
@@ -107,6 +107,25 @@ pub struct DotsSpec {
     /// Which random screen (jittered, stochastic); 0 when left out.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub placement_seed: Option<i64>,
+}
+
+impl DotsSpec {
+    /// The density keys as the file gives them.
+    pub fn density_keys(&self) -> DensityKeys {
+        DensityKeys {
+            density: self.density.clone(),
+            density_table: self.density_table.clone(),
+            density_grid: self.density_grid.clone(),
+        }
+    }
+
+    /// Give the density by `density` (its keys, [`Density::keys`]), in place of the
+    /// file's.
+    pub fn set_density(&mut self, density: &Density) {
+        let keys = density.keys();
+        (self.density, self.density_table, self.density_grid) =
+            (keys.density, keys.density_table, keys.density_grid);
+    }
 }
 
 /// A dielectric face with printed Lambertian ink dots.
@@ -147,11 +166,11 @@ impl Surface for Dots {
         pattern.fit_to_face(ctx, at, n)?;
         let r = face.reach(pattern.origin);
         check_pitch(ctx, &format!("{at}.pitch_mm"), pattern.pitch, r)?;
-        let graded = pattern.gradation();
+        let graded = &pattern.grade;
         if !graded.is_constant() || graded.mirror {
-            check_span(ctx, &format!("{at}.length_mm"), pattern.length, r)?;
+            check_span(ctx, &format!("{at}.length_mm"), graded.length, r)?;
         }
-        if let Density::Grid(g) = &pattern.density {
+        if let Density::Grid(g) = &graded.density {
             check_span(ctx, &format!("{at}.density_grid.width_mm"), g.width, r)?;
         }
         Ok(())
@@ -164,31 +183,9 @@ impl SurfaceSpecOf for DotsSpec {
 
     fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Dots> {
         let f = |k: &str| format!("{at}.{k}");
-        let (density, field) = match (&self.density, &self.density_table, &self.density_grid) {
-            (Some(c), None, None) => (Density::Polynomial(c.clone()), f("density")),
-            (None, Some(k), None) => (Density::Table(k.clone()), f("density_table")),
-            (None, None, Some(g)) => {
-                ctx.non_negative(&f("density_grid.width_mm"), g.width_mm)?;
-                if g.width_mm > crate::spec_check::MAX_COORDINATE {
-                    ctx.length(&f("density_grid.width_mm"), g.width_mm)?;
-                }
-                let x_max = graded_x_max(self.length_mm, self.x_unit, self.mirror);
-                (Density::Grid(g.grid(x_max)), f("density_grid"))
-            }
-            (Some(_), Some(_), _) | (Some(_), _, Some(_)) | (_, Some(_), Some(_)) => {
-                return Err(ctx.err(
-                    &f("density"),
-                    "give only one of density (polynomial), density_table and density_grid",
-                ));
-            }
-            (None, None, None) => {
-                return Err(ctx.err(
-                    &f("density"),
-                    "missing: give density (polynomial coefficients), density_table ([x, d] knots) or density_grid",
-                ));
-            }
-        };
-        let density = density.checked(ctx, &field)?;
+        let length = ctx.length(&f("length_mm"), self.length_mm)?;
+        let x_max = graded_x_max(length, self.x_unit, self.mirror);
+        let (density, field) = Density::from_keys(ctx, at, self.density_keys(), None, x_max)?;
         let lattice = self.lattice;
         let placement = Placement::parse(ctx, &f("placement"), self.placement.as_deref())?;
         let pattern = DotPattern {
@@ -202,10 +199,12 @@ impl SurfaceSpecOf for DotsSpec {
                 Some(a) => ctx.direction(&f("across"), a)?,
                 None => DVec3::ZERO,
             },
-            length: ctx.length(&f("length_mm"), self.length_mm)?,
-            density,
-            x_unit: self.x_unit,
-            mirror: self.mirror,
+            grade: Gradation {
+                density,
+                length,
+                x_unit: self.x_unit,
+                mirror: self.mirror,
+            },
         };
         if let Some((u, d)) = pattern.first_out_of_range() {
             return Err(ctx.err(&field, format!(
@@ -272,14 +271,8 @@ pub struct DotPattern {
     pub axis: DVec3,
     /// Unit in-face direction across the propagation axis.
     pub across: DVec3,
-    /// Span along `axis` covered by the pattern (mm).
-    pub length: f64,
-    /// The density function of the polynomial variable.
-    pub density: Density,
-    /// Unit of the polynomial variable.
-    pub x_unit: XUnit,
-    /// Measure from the nearer of the two edges (lamps on both ends).
-    pub mirror: bool,
+    /// The density graded along `axis`, over the pattern's span.
+    pub grade: Gradation,
     /// Where the dots sit (see [`super::dot_placement`]).
     pub placement: Placement,
     /// Which random screen (jittered, stochastic placements).
@@ -289,35 +282,24 @@ pub struct DotPattern {
 impl DotPattern {
     /// The polynomial variable at distance `u` (mm) along the axis from the origin.
     pub fn x_of(&self, u: f64) -> f64 {
-        graded_x(u, self.length, self.x_unit, self.mirror)
+        self.grade.x_of(u)
     }
 
     /// The density (area fraction) at distance `u` (mm) along the axis.
     pub fn density_at(&self, u: f64) -> f64 {
-        self.density.eval(self.x_of(u))
+        self.grade.at(u)
     }
 
     /// The polynomial variable at the far end of the span (1 when normalized, else the
     /// span in mm: the length, or half of it when mirrored).
     pub fn x_max(&self) -> f64 {
-        graded_x_max(self.length, self.x_unit, self.mirror)
+        graded_x_max(self.grade.length, self.grade.x_unit, self.grade.mirror)
     }
 
     /// Check that the density is finite and within `[0, max packing]` along the whole
     /// span. Returns the first offending position (mm) and value.
     pub fn first_out_of_range(&self) -> Option<(f64, f64)> {
-        self.gradation()
-            .first_outside(0.0, self.lattice.max_packing())
-    }
-
-    /// The density graded along the span, as the range check sees it.
-    pub fn gradation(&self) -> Gradation {
-        Gradation {
-            density: self.density.clone(),
-            length: self.length,
-            x_unit: self.x_unit,
-            mirror: self.mirror,
-        }
+        self.grade.first_outside(0.0, self.lattice.max_packing())
     }
 
     /// Fit the pattern to its face, of unit normal `normal` (its table `at`,
@@ -368,7 +350,7 @@ impl DotPattern {
     /// The density at face coordinates `c` (mm along `axis`, mm along `across`): a grid
     /// uses both, the other densities only the first.
     pub fn density_at_point(&self, c: DVec2) -> f64 {
-        self.density.at(self.x_of(c.x), c.y)
+        self.grade.density.at(self.x_of(c.x), c.y)
     }
 
     /// Radius (mm) of the dot of the cell centred at face coordinates `c`.
@@ -401,10 +383,12 @@ pub(crate) fn test_pattern(lattice: Lattice, density: f64) -> DotPattern {
         origin: DVec3::ZERO,
         axis: DVec3::X,
         across: DVec3::Y,
-        length: 100.0,
-        density: Density::Polynomial(vec![density]),
-        x_unit: XUnit::Normalized,
-        mirror: false,
+        grade: Gradation {
+            density: Density::Polynomial(vec![density]),
+            length: 100.0,
+            x_unit: XUnit::Normalized,
+            mirror: false,
+        },
         placement: Placement::Lattice,
         placement_seed: 0,
     }
@@ -441,8 +425,8 @@ mod tests {
     #[test]
     fn mirror_measures_from_nearer_edge() {
         let mut p = test_pattern(Lattice::Square, 0.0);
-        p.density = Density::Polynomial(vec![0.0, 1.0]);
-        p.mirror = true;
+        p.grade.density = Density::Polynomial(vec![0.0, 1.0]);
+        p.grade.mirror = true;
         assert!((p.x_of(10.0) - 0.2).abs() < 1e-12);
         assert!((p.x_of(90.0) - 0.2).abs() < 1e-12);
         assert!((p.x_of(50.0) - 1.0).abs() < 1e-12);
@@ -465,7 +449,7 @@ mod tests {
         assert!(Density::Table(vec![]).problem().is_some());
         assert!(Density::Polynomial(vec![f64::NAN]).problem().is_some());
         let mut p = test_pattern(Lattice::Square, 0.0);
-        p.density = Density::Table(vec![[0.0, 0.05], [1.0, 0.65]]);
+        p.grade.density = Density::Table(vec![[0.0, 0.05], [1.0, 0.65]]);
         let got = coverage(&p); // patch x 20..30 of 100: mean x = 0.25
         assert!((got - 0.2).abs() < 0.01, "covered {got}");
     }
@@ -487,48 +471,13 @@ mod tests {
     }
 
     #[test]
-    fn agrees_with_the_dot_density_convention() {
-        for (x_unit, mirror) in [
-            (XUnit::Normalized, false),
-            (XUnit::Normalized, true),
-            (XUnit::Mm, false),
-            (XUnit::Mm, true),
-        ] {
-            let density = Density::Polynomial(vec![0.05, 0.2, -0.1, 0.03]);
-            let g = Gradation {
-                density: density.clone(),
-                length: 37.0,
-                x_unit,
-                mirror,
-            };
-            let d = DotPattern {
-                lattice: Lattice::Square,
-                pitch: 0.5,
-                origin: DVec3::ZERO,
-                axis: DVec3::X,
-                across: DVec3::Y,
-                length: 37.0,
-                density,
-                x_unit,
-                mirror,
-                placement: Placement::Lattice,
-                placement_seed: 0,
-            };
-            for k in -3..=40 {
-                let u = k as f64;
-                assert_eq!(g.at(u), d.density_at(u), "{x_unit:?} {mirror} u={u}");
-            }
-        }
-    }
-
-    #[test]
     fn out_of_range_density_is_found() {
         let mut p = test_pattern(Lattice::Square, 0.1);
         assert_eq!(p.first_out_of_range(), None);
-        p.density = Density::Polynomial(vec![0.1, 1.0]);
+        p.grade.density = Density::Polynomial(vec![0.1, 1.0]);
         let (u, d) = p.first_out_of_range().unwrap();
         assert!(d > PI / 4.0 && u > 60.0 && u < 70.0, "u={u} d={d}");
-        p.density = Density::Polynomial(vec![-0.01]);
+        p.grade.density = Density::Polynomial(vec![-0.01]);
         assert!(p.first_out_of_range().is_some());
     }
 }

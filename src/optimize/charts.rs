@@ -26,10 +26,10 @@ impl OptimizeResult {
         let n = 400;
         let curve = |d: &Density| -> Vec<(f64, f64)> {
             let mut q = p.clone();
-            q.density = d.clone();
+            q.grade.density = d.clone();
             (0..=n)
                 .map(|i| {
-                    let u = p.length * i as f64 / n as f64;
+                    let u = p.grade.length * i as f64 / n as f64;
                     (u, q.density_at(u))
                 })
                 .collect()

@@ -67,7 +67,7 @@ pub fn knot_positions(pattern: &DotPattern, n: usize) -> Vec<f64> {
 /// The number of knots for `strips` profile strips: one per strip, or one per mirrored
 /// pair of strips.
 pub fn knot_count(pattern: &DotPattern, strips: usize) -> usize {
-    if pattern.mirror {
+    if pattern.grade.mirror {
         strips.div_ceil(2).max(2)
     } else {
         strips.max(2)
@@ -155,7 +155,7 @@ pub fn initial_grid(
             (0..nx)
                 .map(|i| {
                     let x = x_max * i as f64 / (nx - 1) as f64;
-                    pattern.density.at(x, v).clamp(min, max)
+                    pattern.grade.density.at(x, v).clamp(min, max)
                 })
                 .collect()
         })
@@ -185,7 +185,7 @@ pub fn measured_per_cell(
         for ix in 0..map.nx {
             let centre = d.grid_centre([map.nx, map.ny], ix, iy);
             let q = pattern.face_coords(centre);
-            if !(0.0..pattern.length).contains(&q.x)
+            if !(0.0..pattern.grade.length).contains(&q.x)
                 || q.y < grid.v_min
                 || q.y > grid.v_min + grid.width
             {

@@ -21,7 +21,7 @@ pub(super) fn run_feedback(
             let knots = feedback::knot_positions(&p, feedback::knot_count(&p, search.strips));
             let d = knots
                 .iter()
-                .map(|&x| p.density.eval(x).clamp(search.min, search.max))
+                .map(|&x| p.grade.density.eval(x).clamp(search.min, search.max))
                 .collect();
             let mut table = TableFeedback {
                 pattern: p,
@@ -33,7 +33,7 @@ pub(super) fn run_feedback(
         }
         2 => {
             let cells = search.options.cells.unwrap_or((56, 28));
-            let (v_lo, v_hi) = match &p.density {
+            let (v_lo, v_hi) = match &p.grade.density {
                 Density::Grid(g) => (g.v_min, g.v_min + g.width),
                 _ => face_v_range(search),
             };
@@ -125,7 +125,7 @@ fn feedback_rounds(
     let mut stalled = 0;
     loop {
         let density = if iteration == 0 {
-            search.pattern.density.clone()
+            search.pattern.grade.density.clone()
         } else {
             design.density()
         };

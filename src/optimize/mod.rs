@@ -92,7 +92,7 @@ pub fn optimize(
     let mut search = Search::new(scene, options)?;
     let tag = scene.tags[search.tag_id].clone();
     let dots_placement = export_placement(search.pattern.placement, &tag, options)?;
-    let initial_density = search.pattern.density.clone();
+    let initial_density = search.pattern.grade.density.clone();
     let searched = match options.method {
         Method::NelderMead => run_nelder_mead(&mut search, progress),
         Method::Feedback => run_feedback(&mut search, progress),
@@ -114,7 +114,7 @@ pub fn optimize(
         bail!("the search traced no design");
     };
     let mut pattern = search.pattern.clone();
-    pattern.density = final_density.clone();
+    pattern.grade.density = final_density.clone();
     let face = search.face_triangles();
     let dots = match dots_placement {
         Some(placement) => Some(export::dots_on_face(

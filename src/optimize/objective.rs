@@ -45,14 +45,14 @@ fn strip_of_bins(
 ) -> Vec<Option<usize>> {
     let strips = strips.max(1);
     let d = &scene.detector;
-    let width = pattern.length / strips as f64;
+    let width = pattern.grade.length / strips as f64;
     let mut out = Vec::with_capacity(nx * ny);
     for iy in 0..ny {
         for ix in 0..nx {
             let centre = d.grid_centre([nx, ny], ix, iy);
             let u = (centre - pattern.origin).dot(pattern.axis);
             out.push(
-                (0.0..pattern.length)
+                (0.0..pattern.grade.length)
                     .contains(&u)
                     .then(|| ((u / width) as usize).min(strips - 1)),
             );
@@ -91,7 +91,7 @@ impl Profile {
     /// marked unused.
     pub fn of(scene: &Scene, pattern: &DotPattern, map: &Map, strips: usize, margin: f64) -> Self {
         let strips = strips.max(1);
-        let width = pattern.length / strips as f64;
+        let width = pattern.grade.length / strips as f64;
         let mut sum = vec![0.0; strips];
         let mut var = vec![0.0; strips];
         let mut count = vec![0usize; strips];
@@ -114,7 +114,7 @@ impl Profile {
             p.stderr.push(var[k].sqrt() / n);
             p.populated.push(count[k] > 0);
             p.used
-                .push(count[k] > 0 && u >= margin && u <= pattern.length - margin);
+                .push(count[k] > 0 && u >= margin && u <= pattern.grade.length - margin);
         }
         p
     }

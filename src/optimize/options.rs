@@ -4,6 +4,7 @@ use super::layout::{ObjectiveSpec, VarySpec};
 use crate::accel::BackendChoice;
 use crate::optics::dots::Placement;
 use crate::optics::surface::Estimator;
+use crate::run::RunOptions;
 use anyhow::{Result, bail};
 use serde::Serialize;
 
@@ -154,6 +155,28 @@ impl OptimizeOptions {
     pub fn verification_seed(&self) -> u64 {
         self.verify_seed
             .unwrap_or_else(|| self.seed.wrapping_add(0x9E37_79B9))
+    }
+
+    /// How the search traces each design (both searches: dots and layout).
+    pub fn search_run(&self) -> RunOptions {
+        RunOptions {
+            photons: self.photons,
+            seed: self.seed,
+            threads: self.threads,
+            backend: self.backend,
+            estimator: self.estimator,
+            interrupt: self.interrupt.clone(),
+            ..RunOptions::default()
+        }
+    }
+
+    /// How the first and final designs are traced again with a fresh seed.
+    pub fn verification_run(&self) -> RunOptions {
+        RunOptions {
+            photons: self.verify_photons,
+            seed: self.verification_seed(),
+            ..self.search_run()
+        }
     }
 }
 

@@ -12,14 +12,14 @@ use std::cell::RefCell;
 /// most `degree`, or leaves the allowed range.
 fn start_coefficients(s: &Search, degree: usize) -> Vec<f64> {
     let p = &s.pattern;
-    let mut c = match &p.density {
+    let mut c = match &p.grade.density {
         Density::Polynomial(c) if c.len() <= degree + 1 => c.clone(),
         _ => vec![],
     };
     if c.is_empty() || violation(p, &Density::Polynomial(c.clone()), s.min, s.max) > 0.0 {
         let n = 256;
         let mean = (0..n)
-            .map(|i| p.density_at(p.length * (i as f64 + 0.5) / n as f64))
+            .map(|i| p.density_at(p.grade.length * (i as f64 + 0.5) / n as f64))
             .sum::<f64>()
             / n as f64;
         c = vec![mean.clamp(s.min, s.max)];
@@ -50,7 +50,7 @@ impl Scaling {
 
 /// The polynomial degree: `--degree`, else the scene's, at least 3.
 fn degree(search: &Search) -> usize {
-    let scene_degree = match &search.pattern.density {
+    let scene_degree = match &search.pattern.grade.density {
         Density::Polynomial(c) => c.len().saturating_sub(1),
         Density::Table(_) | Density::Grid(_) => 0,
     };

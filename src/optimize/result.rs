@@ -44,10 +44,8 @@ pub struct OptimizeResult {
     /// The optimized surface's tag.
     pub tag: String,
     /// The first design's density.
-    #[serde(serialize_with = "ser_density")]
     pub initial_density: Density,
     /// The final design's density.
-    #[serde(serialize_with = "ser_density")]
     pub final_density: Density,
     /// One report per iteration.
     pub history: Vec<IterationReport>,
@@ -86,30 +84,4 @@ pub struct OptimizeResult {
     pub(super) initial_run: RunResult,
     #[serde(skip)]
     pub(super) final_run: RunResult,
-}
-
-fn ser_density<S: serde::Serializer>(d: &Density, s: S) -> Result<S::Ok, S::Error> {
-    #[derive(Serialize)]
-    #[serde(rename_all = "snake_case")]
-    enum D<'a> {
-        Polynomial(&'a [f64]),
-        Table(&'a [[f64; 2]]),
-        Grid {
-            x_max: f64,
-            v_min: f64,
-            width: f64,
-            values: &'a [Vec<f64>],
-        },
-    }
-    match d {
-        Density::Polynomial(c) => D::Polynomial(c).serialize(s),
-        Density::Table(k) => D::Table(k).serialize(s),
-        Density::Grid(g) => D::Grid {
-            x_max: g.x_max,
-            v_min: g.v_min,
-            width: g.width,
-            values: &g.values,
-        }
-        .serialize(s),
-    }
 }

@@ -16,7 +16,7 @@
 
 use super::OptimizeResult;
 use crate::optics::dots::Density;
-use crate::scene::config::{DensityGridSpec, SceneFile, SourceSpec, SurfaceSpec};
+use crate::scene::config::{SceneFile, SourceSpec, SurfaceSpec};
 use anyhow::{Context, Result, bail};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -96,24 +96,12 @@ pub(super) fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path
     Ok(())
 }
 
-/// Replace the density of the dots surface `spec` by `density` (the one place that knows
-/// the spec's density fields).
+/// Replace the density of the dots surface `spec` by `density`.
 fn set_density(spec: &mut SurfaceSpec, density: &Density) -> Result<()> {
     let SurfaceSpec::Dots(dots) = spec else {
         bail!("not a model = \"dots\" surface");
     };
-    (dots.density, dots.density_table, dots.density_grid) = (None, None, None);
-    match density {
-        Density::Polynomial(c) => dots.density = Some(c.clone()),
-        Density::Table(k) => dots.density_table = Some(k.clone()),
-        Density::Grid(g) => {
-            dots.density_grid = Some(DensityGridSpec {
-                width_mm: g.width,
-                v_min_mm: g.v_min,
-                values: g.values.clone(),
-            })
-        }
-    }
+    dots.set_density(density);
     Ok(())
 }
 
@@ -167,6 +155,16 @@ mod tests {
             let keys = ["density =", "density_table", "density_grid"];
             let present: Vec<_> = keys.iter().filter(|k| text.contains(*k)).collect();
             assert_eq!(present.len(), 1, "{text}");
+            // The same density comes back from the TOML (a grid's x_max is the
+            // pattern's, not the file's).
+            let SurfaceSpec::Dots(back) = toml::from_str::<SurfaceSpec>(&text).unwrap() else {
+                panic!("{text}");
+            };
+            let ctx = crate::spec_check::Ctx(&path);
+            let x_max = 1.0;
+            let (again, _) =
+                Density::from_keys(&ctx, "s", back.density_keys(), None, x_max).unwrap();
+            assert_eq!(again, density, "{text}");
         }
         let mut other = file.surfaces.get("lgp_front").unwrap().clone();
         assert!(set_density(&mut other, &Density::Polynomial(vec![0.1])).is_err());

@@ -4,7 +4,7 @@ use super::OptimizeOptions;
 use super::objective::{self, Evaluation};
 use super::report::IterationReport;
 use super::traced::{self, dots_pattern};
-use crate::optics::dots::{Density, DotPattern};
+use crate::optics::dots::{Density, DotPattern, Gradation};
 use crate::optics::surface::SurfaceModel;
 use crate::run::RunResult;
 use crate::run::{MeshBuildCache, RunOptions};
@@ -60,34 +60,11 @@ fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
 /// How far `density` leaves `[min, max]` anywhere on the pattern's span (0: feasible;
 /// infinite for non-finite values).
 pub fn violation(pattern: &DotPattern, density: &Density, min: f64, max: f64) -> f64 {
-    if let Density::Grid(g) = density {
-        // Bilinear values lie between the knots'.
-        return g
-            .values
-            .iter()
-            .flatten()
-            .map(|&d| {
-                if d.is_finite() {
-                    (min - d).max(d - max).max(0.0)
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .fold(0.0, f64::max);
-    }
-    let samples = 2048;
-    let mut p = pattern.clone();
-    p.density = density.clone();
-    (0..=samples)
-        .map(|i| p.density_at(p.length * i as f64 / samples as f64))
-        .map(|d| {
-            if d.is_finite() {
-                (min - d).max(d - max).max(0.0)
-            } else {
-                f64::INFINITY
-            }
-        })
-        .fold(0.0, f64::max)
+    let grade = Gradation {
+        density: density.clone(),
+        ..pattern.grade.clone()
+    };
+    grade.worst_excess(min, max, 2048)
 }
 
 /// The allowed density range `[min printable, max packing]`, checked.
@@ -114,11 +91,11 @@ fn checked_strips(scene: &Scene, options: &OptimizeOptions, pattern: &DotPattern
     if strips < 2 {
         bail!("need at least 2 profile strips, got {strips}");
     }
-    if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.length) {
+    if !(options.edge_margin_mm >= 0.0 && 2.0 * options.edge_margin_mm < pattern.grade.length) {
         bail!(
             "option `edge_margin_mm` {} must be >= 0 and leave part of the {:.1} mm span",
             options.edge_margin_mm,
-            pattern.length
+            pattern.grade.length
         );
     }
     Ok(strips)
@@ -155,15 +132,7 @@ impl<'a> Search<'a> {
         let pattern = dots_pattern(scene, tag_id)?.clone();
         let (min, max) = density_range(options, &pattern)?;
         let strips = checked_strips(scene, options, &pattern)?;
-        let run_options = RunOptions {
-            photons: options.photons,
-            seed: options.seed,
-            threads: options.threads,
-            backend: options.backend,
-            estimator: options.estimator,
-            interrupt: options.interrupt.clone(),
-            ..RunOptions::default()
-        };
+        let run_options = options.search_run();
         Ok(Search {
             scene,
             tag_id,
@@ -188,7 +157,7 @@ impl<'a> Search<'a> {
     pub(super) fn scene_with(&self, density: &Density) -> Scene {
         let mut scene = self.scene.clone();
         if let Some(SurfaceModel::Dots(d)) = scene.surfaces.get_mut(self.tag_id) {
-            d.pattern.density = density.clone();
+            d.pattern.grade.density = density.clone();
         }
         scene
     }

@@ -20,11 +20,7 @@ pub(super) fn verify(
     if options.verify_photons == 0 {
         return Ok(None);
     }
-    let run_options = RunOptions {
-        photons: options.verify_photons,
-        seed: options.verification_seed(),
-        ..search.run_options.clone()
-    };
+    let run_options = options.verification_run();
     let (initial_run, initial) = verify_design(search, &run_options, initial_density)?;
     let (final_run, final_design) = verify_design(search, &run_options, final_density)?;
     let verification = Verification {

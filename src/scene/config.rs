@@ -43,7 +43,6 @@
 
 pub use super::geometry_file::GeometrySpec;
 pub use super::procedural::ProceduralSpec;
-pub use crate::optics::density::DensityGridSpec;
 pub use crate::optics::medium::MediumSpec;
 pub use crate::optics::surface::SurfaceSpec;
 pub use crate::sources::SourceSpec;

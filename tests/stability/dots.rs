@@ -20,10 +20,12 @@ pub(super) fn dots_density_extremes() -> Row {
                 origin,
                 axis,
                 across,
-                length: 1500.0,
-                density: Density::Polynomial(vec![d]),
-                x_unit: XUnit::Normalized,
-                mirror: false,
+                grade: Gradation {
+                    density: Density::Polynomial(vec![d]),
+                    length: 1500.0,
+                    x_unit: XUnit::Normalized,
+                    mirror: false,
+                },
                 placement: Placement::Lattice,
                 placement_seed: 0,
             };

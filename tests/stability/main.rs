@@ -40,7 +40,7 @@ use thin_plate::*;
 
 use blutrace::accel::{self, BackendChoice};
 use blutrace::geometry::{Mesh, Ray, SurfaceHit, intersect_triangle};
-use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement, XUnit};
+use blutrace::optics::dots::{Density, DotPattern, Gradation, Lattice, Placement, XUnit};
 use blutrace::optics::fresnel;
 use blutrace::optics::surface::{Estimator, Interface, Medium, Outcome, SurfaceModel};
 use blutrace::rng::PhotonRng;

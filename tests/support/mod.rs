@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use blutrace::accel::BackendChoice;
-use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement, XUnit};
+use blutrace::optics::dots::{Density, DotPattern, Gradation, Lattice, Placement, XUnit};
 use blutrace::run::{self, RunOptions, RunResult};
 use blutrace::scene::Scene;
 use std::fmt::Write;
@@ -271,10 +271,12 @@ pub fn dot_pattern(lattice: Lattice, density: Density, length: f64) -> DotPatter
         origin: glam::DVec3::ZERO,
         axis: glam::DVec3::X,
         across: glam::DVec3::Y,
-        length,
-        density,
-        x_unit: XUnit::Normalized,
-        mirror: false,
+        grade: Gradation {
+            density,
+            length,
+            x_unit: XUnit::Normalized,
+            mirror: false,
+        },
         placement: Placement::Lattice,
         placement_seed: 0,
     }

@@ -2,7 +2,9 @@
 //! [`super`]).
 
 use super::pattern::{GroovePattern, Relief};
-use crate::optics::density::{Density, Gradation, XUnit, check_cells, check_pitch, check_span};
+use crate::optics::density::{
+    Density, DensityKeys, Gradation, XUnit, check_cells, check_pitch, check_span,
+};
 use crate::optics::dielectric;
 use crate::optics::medium::{Interface, Medium, air};
 use crate::optics::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
@@ -124,19 +126,15 @@ impl SurfaceSpecOf for GroovesSpec {
                 ),
             ));
         }
-        let (fill, field) = match (&self.density, &self.density_table) {
-            (Some(c), None) => (Density::Polynomial(c.clone()), f("density")),
-            (None, Some(k)) => (Density::Table(k.clone()), f("density_table")),
-            (None, None) => (Density::Polynomial(vec![1.0]), f("density")),
-            (Some(_), Some(_)) => {
-                return Err(ctx.err(
-                    &f("density"),
-                    "give either density (polynomial) or density_table, not both",
-                ));
-            }
+        let keys = DensityKeys {
+            density: self.density.clone(),
+            density_table: self.density_table.clone(),
+            density_grid: None,
         };
+        let constant = Some(Density::Polynomial(vec![1.0]));
+        let (fill, field) = Density::from_keys(ctx, at, keys, constant, 1.0)?;
         let mut gradation = Gradation {
-            density: fill.checked(ctx, &field)?,
+            density: fill,
             length: 1.0,
             x_unit: self.x_unit,
             mirror: self.mirror,

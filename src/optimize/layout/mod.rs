@@ -35,7 +35,7 @@ pub use write::OUTPUT_NAMES;
 
 use super::nelder_mead::{self, Settings};
 use super::{Method, OptimizeOptions};
-use crate::run::{RunOptions, is_interrupted};
+use crate::run::is_interrupted;
 use crate::scene::Scene;
 use anyhow::{Result, bail};
 use search::{LayoutSearch, PENALTY};
@@ -66,15 +66,7 @@ pub fn optimize_layout(
         vars,
         objective: options.objective.clone(),
         options,
-        run_options: RunOptions {
-            photons: options.photons,
-            seed: options.seed,
-            threads: options.threads,
-            backend: options.backend,
-            estimator: options.estimator,
-            interrupt: options.interrupt.clone(),
-            ..RunOptions::default()
-        },
+        run_options: options.search_run(),
         start: Instant::now(),
         photons: 0,
         history: Vec::new(),

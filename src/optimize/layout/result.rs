@@ -5,8 +5,8 @@ use super::search::{EvaluationRecord, LayoutSearch};
 
 use crate::optimize::{Method, OptimizeOptions};
 use crate::run::RunResult;
+use crate::run::is_interrupted;
 use crate::run::summary::Summary;
-use crate::run::{RunOptions, is_interrupted};
 use anyhow::Result;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -140,11 +140,7 @@ pub(super) fn finish(
     let verified = if options.verify_photons == 0 || interrupted {
         None
     } else {
-        let run_options = RunOptions {
-            photons: options.verify_photons,
-            seed: options.verification_seed(),
-            ..search.run_options.clone()
-        };
+        let run_options = options.verification_run();
         let verify = |x: &[f64]| -> Result<(RunResult, VerifiedLayout)> {
             let (run, evaluation) = search.trace(search.design(x)?, &run_options)?;
             let summary = run.summary();

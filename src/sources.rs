@@ -38,6 +38,7 @@ pub mod intensity;
 use crate::geometry::{Ray, orthonormal_basis};
 use crate::optics::medium::{Medium, MediumId, air, medium_id};
 use crate::optics::sampling;
+use crate::optics::spectrum::Light;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -335,6 +336,8 @@ pub struct Emission {
     pub medium: MediumId,
     /// The index of the source that emitted it.
     pub source: usize,
+    /// Its light (see [`crate::optics::spectrum`]).
+    pub light: Light,
 }
 
 impl Source {
@@ -620,6 +623,7 @@ impl Sources {
             normal,
             medium: s.medium,
             source: i,
+            light: Light::MONOCHROME,
         }
     }
 

@@ -25,6 +25,8 @@ use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
 use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::absorber::Absorber;
+use crate::optics::model::Arrival;
+use crate::optics::spectrum::Light;
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
@@ -73,6 +75,8 @@ struct Photon {
     ray: SpawnedRay,
     medium: MediumId,
     weight: f64,
+    /// Its light, drawn with its emission: what it meets is read at it.
+    light: Light,
     /// Analog estimator: the optical depth of clear-medium absorption the photon has
     /// left (an Exp(1) draw, made on its first absorbing segment; negative until then).
     absorption_depth: f64,
@@ -118,6 +122,7 @@ impl<'a> Tracer<'a> {
             ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
             medium: e.medium,
             weight: 1.0,
+            light: e.light,
             absorption_depth: -1.0,
         };
         out.ledger.photons += 1;
@@ -156,22 +161,24 @@ impl<'a> Tracer<'a> {
                 Flight::Reached => {}
             }
             if let Some((_, ab)) = detected {
+                let weight = p.light.detected(p.weight);
                 out.detections
-                    .push(detection(scene, ab, true_ray.dir, p.weight));
+                    .push(detection(scene, ab, true_ray.dir, weight));
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
                 return Fate::Escaped;
             };
             let model = self.model(struck);
-            let (outcome, feature) = model.interact_on(
-                &scene.media,
-                &surf,
-                true_ray.dir,
-                p.medium,
-                self.estimator,
-                rng,
-            );
+            let at = Arrival {
+                media: &scene.media,
+                hit: &surf,
+                dir: true_ray.dir,
+                medium: p.medium,
+                est: self.estimator,
+                light: p.light,
+            };
+            let (outcome, feature) = model.interact_on(&at, rng);
             struck.count(&mut out.ledger, feature);
             match outcome {
                 Outcome::Absorbed => return struck.absorbed(),
@@ -300,15 +307,15 @@ impl<'a> Tracer<'a> {
         let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
         if medium.scattering.per_mm > 0.0 {
             let eps = self.scene.spawn_eps;
-            let (w, dir) = (&mut p.weight, true_ray.dir);
-            let flight = flight::fly(medium, self.estimator, w, dir, t, eps, rng, sink);
+            let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
+            let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
             if let Flight::Scattered { t, dir } = flight {
                 // Inside the medium, clear of surfaces: the search needs no nudge.
                 p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
             }
             return flight;
         }
-        if absorb_clear(p, medium.absorption_per_mm, t, self.estimator, rng, sink) {
+        if absorb_clear(p, medium.absorption(p.light), t, self.estimator, rng, sink) {
             Flight::Absorbed
         } else {
             Flight::Reached

@@ -184,13 +184,15 @@ fn altered(scene: &Scene, what: &str) -> Scene {
     let mut s = scene.clone();
     for m in &mut s.surfaces {
         match (m, what) {
-            (SurfaceModel::Dots(d), "ink albedo x 0.95") => d.ink_albedo *= 0.95,
-            (SurfaceModel::Lambert(l), "sheet albedo x 0.95") => l.albedo *= 0.95,
+            (SurfaceModel::Dots(d), "ink albedo x 0.95") => {
+                d.ink_albedo = d.ink_albedo.scaled(0.95)
+            }
+            (SurfaceModel::Lambert(l), "sheet albedo x 0.95") => l.albedo = l.albedo.scaled(0.95),
             _ => {}
         }
     }
     if what == "n = 1.40" {
-        s.media[1].n = 1.40;
+        s.media[1].n = 1.40.into();
     }
     s
 }

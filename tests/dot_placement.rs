@@ -16,6 +16,8 @@ mod support;
 
 use blutrace::estimator::Estimator;
 use blutrace::optics::dots::{Density, DotPattern, Lattice, Placement};
+use blutrace::optics::model::Arrival;
+use blutrace::optics::spectrum::Light;
 use blutrace::optimize::export;
 use blutrace::rng::PhotonRng;
 use blutrace::run::{RunOptions, RunResult};
@@ -560,8 +562,15 @@ fn walk(scene: &Scene, pitch: f64, random_phase: bool, photons: u64) -> (f64, f6
                 point: p + shift,
                 normal,
             };
-            let (out, feature) =
-                model.interact_on(&scene.media, &hit, dir, pmma, Estimator::Analog, &mut rng);
+            let at = Arrival {
+                media: &scene.media,
+                hit: &hit,
+                dir,
+                medium: pmma,
+                est: Estimator::Analog,
+                light: Light::MONOCHROME,
+            };
+            let (out, feature) = model.interact_on(&at, &mut rng);
             if z == 0.0 {
                 hits += 1;
                 features += u64::from(feature != Feature::Plain);

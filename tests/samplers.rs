@@ -262,7 +262,7 @@ fn phong_directions_follow_the_phong_brdf_and_lose_the_lobe_below_the_surface() 
     let facing = tilted_axis();
     for (specular, exponent, incidence_deg) in [(0.7, 5.0, 70.0), (0.4, 30.0, 45.0)] {
         let p = Phong {
-            reflectance: 0.9,
+            reflectance: 0.9.into(),
             specular,
             exponent,
         };

@@ -214,7 +214,7 @@ impl BoxScene {
             bail!(refuse(scene, "it needs exactly one medium besides air"));
         }
         let (air, guide) = (&scene.media[0], &scene.media[1]);
-        if air.absorption_per_mm != 0.0 || air.scattering.per_mm != 0.0 {
+        if air.absorption_per_mm.nominal() != 0.0 || air.scattering.per_mm != 0.0 {
             bail!(refuse(scene, "the air must be clear"));
         }
         if guide.scattering.per_mm != 0.0 {
@@ -289,9 +289,9 @@ impl BoxScene {
         Ok(BoxScene {
             lo,
             hi,
-            n_guide: guide.n as f32,
-            n_air: air.n as f32,
-            absorption: guide.absorption_per_mm as f32,
+            n_guide: guide.n.nominal() as f32,
+            n_air: air.n.nominal() as f32,
+            absorption: guide.absorption_per_mm.nominal() as f32,
             dots,
             sheet,
             sheet_albedo,
@@ -389,7 +389,7 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
         pitch: p as f32,
         col0: lo_col,
         r2,
-        ink_albedo: ink_albedo as f32,
+        ink_albedo: ink_albedo.nominal() as f32,
     })
 }
 
@@ -421,7 +421,7 @@ fn sheet_of(scene: &Scene, prims: &[u32], tol: f64) -> Result<(AaRect, f32, usiz
         })
         .sum();
     match AaRect::bounding(&pts, tol) {
-        Some(r) if (r.area() - area).abs() <= 1e-6 * area => Ok((r, albedo as f32, tag)),
+        Some(r) if (r.area() - area).abs() <= 1e-6 * area => Ok((r, albedo.nominal() as f32, tag)),
         _ => bail!(refuse(
             scene,
             format!(
@@ -459,7 +459,9 @@ fn strip_of(scene: &Scene) -> Result<Strip> {
         None => Body::Transparent,
         Some(b) => match (&b.shape, &b.model) {
             (BodyShape::Rectangle(_), SurfaceModel::Absorber(_)) => Body::Absorber,
-            (BodyShape::Rectangle(_), SurfaceModel::Lambert(l)) => Body::Lambert(l.albedo as f32),
+            (BodyShape::Rectangle(_), SurfaceModel::Lambert(l)) => {
+                Body::Lambert(l.albedo.nominal() as f32)
+            }
             _ => bail!(refuse(
                 scene,
                 "the LED's body must be its rectangle, absorbing or Lambertian"

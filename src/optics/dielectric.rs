@@ -51,7 +51,7 @@ impl Surface for Interface {
 /// Fresnel roulette at the smooth interface `i` for the photon of `at`.
 #[inline]
 pub fn smooth(at: &Arrival, i: &Interface, rng: &mut PhotonRng) -> Outcome {
-    let (dir, medium) = scatter(at.media, i, at.hit.normal, at.dir, rng);
+    let (dir, medium) = scatter(at, i, rng);
     Outcome::Scattered {
         dir,
         medium,
@@ -59,22 +59,17 @@ pub fn smooth(at: &Arrival, i: &Interface, rng: &mut PhotonRng) -> Outcome {
     }
 }
 
-/// Fresnel roulette at a smooth interface with outward unit `normal`: the photon's new
+/// Fresnel roulette of the photon of `at` at the smooth interface `iface`: its new
 /// direction and the medium it now travels in.
-pub fn scatter(
-    media: &[Medium],
-    iface: &Interface,
-    normal: DVec3,
-    dir: DVec3,
-    rng: &mut PhotonRng,
-) -> (DVec3, MediumId) {
+pub fn scatter(at: &Arrival, iface: &Interface, rng: &mut PhotonRng) -> (DVec3, MediumId) {
+    let (normal, dir) = (at.hit.normal, at.dir);
+    let (n_inside, n_outside) = at.indices(iface);
     let entering = dir.dot(normal) < 0.0;
-    let (from, to, facing) = if entering {
-        (iface.outside, iface.inside, normal)
+    let (from, to, facing, n1, n2) = if entering {
+        (iface.outside, iface.inside, normal, n_outside, n_inside)
     } else {
-        (iface.inside, iface.outside, -normal)
+        (iface.inside, iface.outside, -normal, n_inside, n_outside)
     };
-    let (n1, n2) = (media[from as usize].n, media[to as usize].n);
     match fresnel::roulette(dir, facing, n1, n2, rng) {
         Some(t) => (t, to),
         None => (fresnel::reflect(dir, facing), from),

@@ -54,6 +54,7 @@ use super::density::{check_pitch, check_span};
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 pub use super::placement::Placement;
+use super::spectrum::Spectral;
 use super::{dielectric, lambert};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -137,7 +138,7 @@ pub struct Dots {
     /// leaves it to the face).
     pub pattern: DotPattern,
     /// Albedo of the ink (the rest is absorbed).
-    pub ink_albedo: f64,
+    pub ink_albedo: Spectral,
 }
 
 impl Surface for Dots {
@@ -215,7 +216,7 @@ impl SurfaceSpecOf for DotsSpec {
         Ok(Dots {
             interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             pattern,
-            ink_albedo: ctx.fraction(&f("ink_albedo"), self.ink_albedo)?,
+            ink_albedo: ctx.fraction(&f("ink_albedo"), self.ink_albedo)?.into(),
         })
     }
 }

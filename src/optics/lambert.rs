@@ -11,6 +11,7 @@
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::sampling;
+use super::spectrum::Spectral;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -29,7 +30,7 @@ pub struct LambertSpec {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambert {
     /// Diffuse reflectance.
-    pub albedo: f64,
+    pub albedo: Spectral,
 }
 
 impl SurfaceSpecOf for LambertSpec {
@@ -37,7 +38,9 @@ impl SurfaceSpecOf for LambertSpec {
 
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Lambert> {
         let albedo = ctx.fraction(&format!("{at}.albedo"), self.albedo)?;
-        Ok(Lambert { albedo })
+        Ok(Lambert {
+            albedo: albedo.into(),
+        })
     }
 }
 

@@ -29,6 +29,7 @@
 
 use super::phase::{self, PhaseTable};
 use super::sampling;
+use super::spectrum::{Light, Spectral};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -44,10 +45,11 @@ pub type MediumId = u16;
 pub struct Medium {
     /// Name from the scene file.
     pub name: String,
-    /// Refractive index.
-    pub n: f64,
-    /// Beer-Lambert absorption coefficient (1/mm): the bulk's and its particles'.
-    pub absorption_per_mm: f64,
+    /// Refractive index (read at a photon's light with [`Medium::index`]).
+    pub n: Spectral,
+    /// Beer-Lambert absorption coefficient (1/mm): the bulk's and its particles' (read at
+    /// a photon's light with [`Medium::absorption`]).
+    pub absorption_per_mm: Spectral,
     /// Scattering inside the medium ([`Scattering::NONE`] for a clear one).
     pub scattering: Scattering,
     /// The particles the scattering was computed from, if any (for reports).
@@ -64,15 +66,27 @@ impl Medium {
     /// scattering): a face may name it outside with no solid around it, as an
     /// index-matched black coating of no thickness.
     pub fn is_backing(&self) -> bool {
-        self.absorption_per_mm >= BACKING_PER_MM && self.scattering.per_mm == 0.0
+        self.absorption_per_mm.nominal() >= BACKING_PER_MM && self.scattering.per_mm == 0.0
+    }
+
+    /// The refractive index for a photon of light `light`.
+    #[inline]
+    pub fn index(&self, light: Light) -> f64 {
+        self.n.at(light)
+    }
+
+    /// The absorption coefficient (1/mm) for a photon of light `light`.
+    #[inline]
+    pub fn absorption(&self, light: Light) -> f64 {
+        self.absorption_per_mm.at(light)
     }
 
     /// A medium that does not scatter.
     pub fn clear(name: &str, n: f64, absorption_per_mm: f64) -> Medium {
         Medium {
             name: name.to_string(),
-            n,
-            absorption_per_mm,
+            n: Spectral::constant(n),
+            absorption_per_mm: Spectral::constant(absorption_per_mm),
             scattering: Scattering::NONE,
             particles: None,
         }
@@ -256,8 +270,8 @@ impl MediumSpec {
         }
         Ok(Medium {
             name: name.to_string(),
-            n,
-            absorption_per_mm: absorption,
+            n: Spectral::constant(n),
+            absorption_per_mm: Spectral::constant(absorption),
             scattering,
             particles: self.particles.clone(),
         })

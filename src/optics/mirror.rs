@@ -9,6 +9,7 @@
 use super::fresnel;
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::spectrum::Spectral;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -32,7 +33,7 @@ fn one() -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mirror {
     /// Reflectance.
-    pub reflectance: f64,
+    pub reflectance: Spectral,
 }
 
 impl SurfaceSpecOf for MirrorSpec {
@@ -40,7 +41,9 @@ impl SurfaceSpecOf for MirrorSpec {
 
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Mirror> {
         let reflectance = ctx.fraction(&format!("{at}.reflectance"), self.reflectance)?;
-        Ok(Mirror { reflectance })
+        Ok(Mirror {
+            reflectance: reflectance.into(),
+        })
     }
 }
 

@@ -8,8 +8,8 @@
 //! [`absorber`]; [`surface`] joins them into the per-tag model and its Russian roulette.
 //! Shared by several: [`medium`] (media and interfaces; volume scattering with
 //! [`phase`] and [`mie`]), [`fresnel`] (Fresnel equations
-//! and roulette), [`sampling`] (direction sampling) and [`density`] (values graded along
-//! a guide).
+//! and roulette), [`sampling`] (direction sampling) [`density`] (values graded along
+//! a guide) and [`spectrum`] (the light a photon carries and the quantities read at it).
 
 pub mod absorber;
 pub mod density;
@@ -28,4 +28,5 @@ pub mod phase;
 pub mod phong;
 pub mod placement;
 pub mod sampling;
+pub mod spectrum;
 pub mod surface;

@@ -4,6 +4,7 @@
 //! and are registered in [`super::surface`].
 
 use super::medium::{Interface, Medium, MediumId};
+use super::spectrum::{Light, Spectral};
 use crate::estimator::Estimator;
 use crate::geometry::{Mesh, SurfaceHit};
 use crate::rng::PhotonRng;
@@ -87,6 +88,8 @@ pub struct Arrival<'a> {
     pub medium: MediumId,
     /// Analog roulette or absorption by weights.
     pub est: Estimator,
+    /// Its light: the optical quantities it meets are read at it ([`super::spectrum`]).
+    pub light: Light,
 }
 
 impl Arrival<'_> {
@@ -100,16 +103,17 @@ impl Arrival<'_> {
         }
     }
 
-    /// An opaque reflection: survival of the albedo by the estimator, then a direction
-    /// from `sample` back into the photon's medium (`None`: absorbed there).
+    /// An opaque reflection: survival of the albedo (read at the photon's light) by the
+    /// estimator, then a direction from `sample` back into the photon's medium (`None`:
+    /// absorbed there).
     #[inline]
     pub fn reflect(
         &self,
-        albedo: f64,
+        albedo: Spectral,
         rng: &mut PhotonRng,
         sample: impl FnOnce(&mut PhotonRng) -> Option<DVec3>,
     ) -> Outcome {
-        let Some(weight) = self.est.survive(albedo, rng) else {
+        let Some(weight) = self.est.survive(albedo.at(self.light), rng) else {
             return Outcome::Absorbed;
         };
         match sample(rng) {
@@ -137,8 +141,8 @@ impl Arrival<'_> {
     #[inline]
     pub fn indices(&self, i: &Interface) -> (f64, f64) {
         (
-            self.media[i.inside as usize].n,
-            self.media[i.outside as usize].n,
+            self.media[i.inside as usize].index(self.light),
+            self.media[i.outside as usize].index(self.light),
         )
     }
 }

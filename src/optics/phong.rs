@@ -13,6 +13,7 @@
 
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::spectrum::Spectral;
 use super::{fresnel, lambert, sampling};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -36,7 +37,7 @@ pub struct PhongSpec {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Phong {
     /// Total reflectance (diffuse + specular).
-    pub reflectance: f64,
+    pub reflectance: Spectral,
     /// Fraction of the reflected energy in the specular lobe.
     pub specular: f64,
     /// Phong exponent of the specular lobe.
@@ -49,7 +50,7 @@ impl SurfaceSpecOf for PhongSpec {
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Phong> {
         let f = |k: &str| format!("{at}.{k}");
         Ok(Phong {
-            reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?,
+            reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?.into(),
             specular: ctx.fraction(&f("specular"), self.specular)?,
             exponent: ctx.positive(&f("exponent"), self.exponent)?,
         })

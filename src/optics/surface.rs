@@ -29,6 +29,7 @@ use super::grooves::{Grooves, GroovesSpec};
 use super::lambert::{Lambert, LambertSpec};
 use super::mirror::{Mirror, MirrorSpec};
 use super::phong::{Phong, PhongSpec};
+use super::spectrum::Light;
 use crate::geometry::SurfaceHit;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -64,18 +65,9 @@ macro_rules! surface_models {
             /// [`SurfaceModel::interact`], also saying what part of a patterned face the
             /// photon met (ink, a groove, or the plain surface), for the per-tag hit counts.
             #[inline]
-            pub fn interact_on(
-                &self,
-                media: &[Medium],
-                hit: &SurfaceHit,
-                dir: DVec3,
-                medium: MediumId,
-                est: Estimator,
-                rng: &mut PhotonRng,
-            ) -> (Outcome, Feature) {
-                let at = Arrival { media, hit, dir, medium, est };
+            pub fn interact_on(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
                 match self {
-                    $( SurfaceModel::$Variant(m) => m.interact(&at, rng), )*
+                    $( SurfaceModel::$Variant(m) => m.interact(at, rng), )*
                 }
             }
 
@@ -149,7 +141,8 @@ surface_models! {
 }
 
 impl SurfaceModel {
-    /// Roulette the fate of a photon arriving along `dir` in `medium` at `hit`.
+    /// Roulette the fate of a photon of monochrome light arriving along `dir` in `medium`
+    /// at `hit` (the tracer's photons carry their light: [`SurfaceModel::interact_on`]).
     #[inline]
     pub fn interact(
         &self,
@@ -160,6 +153,15 @@ impl SurfaceModel {
         est: Estimator,
         rng: &mut PhotonRng,
     ) -> Outcome {
-        self.interact_on(media, hit, dir, medium, est, rng).0
+        let light = Light::MONOCHROME;
+        let at = Arrival {
+            media,
+            hit,
+            dir,
+            medium,
+            est,
+            light,
+        };
+        self.interact_on(&at, rng).0
     }
 }

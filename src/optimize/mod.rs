@@ -47,6 +47,7 @@
 //! (`write`, with `scene_edit` for `optimized.toml` and `charts` for the PNG charts).
 
 mod charts;
+mod design;
 pub mod export;
 pub mod feedback;
 mod feedback_search;
@@ -59,7 +60,6 @@ mod report;
 mod result;
 mod scene_edit;
 mod search;
-mod traced;
 mod verify;
 mod write;
 

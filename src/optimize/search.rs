@@ -1,9 +1,9 @@
 //! The state of one search: the design space, the traces so far, the best design.
 
 use super::OptimizeOptions;
+use super::design::{Design, dots_pattern};
 use super::objective::{self, Evaluation};
 use super::report::IterationReport;
-use super::traced::{self, dots_pattern};
 use crate::optics::dots::{Density, DotPattern, Gradation};
 use crate::optics::surface::SurfaceModel;
 use crate::run::RunResult;
@@ -153,15 +153,6 @@ impl<'a> Search<'a> {
         })
     }
 
-    /// The scene with the dots surface's density replaced.
-    pub(super) fn scene_with(&self, density: &Density) -> Scene {
-        let mut scene = self.scene.clone();
-        if let Some(SurfaceModel::Dots(d)) = scene.surfaces.get_mut(self.tag_id) {
-            d.pattern.grade.density = density.clone();
-        }
-        scene
-    }
-
     /// The figure of merit and its standard error: for the 2-D feedback the area cv (the
     /// non-uniformity it can fix is across the axis too) debiased by its noise floor
     /// `sqrt(cv^2 - floor^2)` (per-bin noise dominates the raw area cv at few photons),
@@ -181,14 +172,7 @@ impl<'a> Search<'a> {
     /// Trace a design with the search's seed and photons; keeps the first and the best.
     pub(super) fn evaluate(&mut self, density: &Density) -> Result<Evaluation> {
         self.evaluations += 1;
-        let (run, ev) = traced::trace_design(
-            self.scene_with(density),
-            &self.run_options,
-            self.strips,
-            self.options.edge_margin_mm,
-            self.tag_id,
-            &mut self.builds.borrow_mut(),
-        )?;
+        let (run, ev) = self.trace(density, &self.run_options)?;
         self.photons += ev.photons;
         if self.first.is_none() {
             self.first = Some((run.clone(), ev.clone()));
@@ -238,6 +222,38 @@ impl<'a> Search<'a> {
         };
         progress(&r);
         self.history.push(r);
+    }
+}
+
+/// A dot-density design: the scene with the dots surface's density replaced, judged by
+/// its profile (or area) uniformity.
+impl Design for Search<'_> {
+    type Point = Density;
+    type Judged = Evaluation;
+
+    fn scene(&self, density: &Density) -> Result<Scene> {
+        let mut scene = self.scene.clone();
+        if let Some(SurfaceModel::Dots(d)) = scene.surfaces.get_mut(self.tag_id) {
+            d.pattern.grade.density = density.clone();
+        }
+        Ok(scene)
+    }
+
+    fn judge(&self, r: &RunResult) -> Result<Evaluation> {
+        let pattern = dots_pattern(&r.scene, self.tag_id)?;
+        Ok(Evaluation::of(
+            &r.scene,
+            pattern,
+            r.flux_map(),
+            self.strips,
+            self.options.edge_margin_mm,
+            r.tally.ledger.photons,
+            r.runtime_s,
+        ))
+    }
+
+    fn builds(&self) -> &RefCell<MeshBuildCache> {
+        &self.builds
     }
 }
 

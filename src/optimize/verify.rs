@@ -1,8 +1,8 @@
 //! The verification: the first and the final design re-traced with a seed no evaluation
 //! used and `--verify-photons` photons.
 
+use super::design::Design;
 use super::search::Search;
-use super::traced;
 use super::{Verification, VerifiedDesign};
 use crate::optics::dots::Density;
 use crate::run::RunOptions;
@@ -38,14 +38,7 @@ fn verify_design(
     run_options: &RunOptions,
     density: &Density,
 ) -> Result<(RunResult, VerifiedDesign)> {
-    let (run, evaluation) = traced::trace_design(
-        search.scene_with(density),
-        run_options,
-        search.strips,
-        search.options.edge_margin_mm,
-        search.tag_id,
-        &mut search.builds.borrow_mut(),
-    )?;
+    let (run, evaluation) = search.trace(density, run_options)?;
     let summary = run.summary();
     let design = VerifiedDesign {
         evaluation,

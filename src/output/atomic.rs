@@ -213,16 +213,16 @@ pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
         Ok(m) => m,
     };
     if !meta.is_dir() {
-        bail!("{shown}: exists and is not a folder; give --out a folder");
+        bail!("{shown}: exists and is not a folder; choose a folder for the outputs");
     }
     let real = fs::canonicalize(dest).with_context(|| format!("{shown}: cannot resolve"))?;
     if std::env::current_dir().and_then(fs::canonicalize).ok() == Some(real.clone()) {
         bail!(
-            "{shown}: is the current directory, which the new output set would replace; give --out a folder inside it"
+            "{shown}: is the current directory, which the new output set would replace; choose a folder inside it"
         );
     }
     if is_mount_point(&real) {
-        bail!("{shown}: is a mount point, which cannot be replaced; give --out a folder inside it");
+        bail!("{shown}: is a mount point, which cannot be replaced; choose a folder inside it");
     }
     let mut ours: Vec<String> = may_write.iter().map(|s| s.to_string()).collect();
     ours.extend(manifest_entries(&real));
@@ -240,7 +240,7 @@ pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
         let more = if foreign.len() > 5 { ", ..." } else { "" };
         foreign.truncate(5);
         bail!(
-            "{shown}: holds {} that blutrace did not write; a run replaces the whole output folder, so move them or give --out a new folder",
+            "{shown}: holds {} that blutrace did not write; a run replaces the whole output folder, so move them or choose a new output folder",
             foreign.join(", ") + more
         );
     }
@@ -256,7 +256,7 @@ pub fn check_apart(dest: &Path, inputs: &[&Path]) -> Result<()> {
     for input in inputs {
         if resolved(input).starts_with(&out) {
             bail!(
-                "{}: is or holds the input {}, which writing the outputs there would delete; give --out another folder",
+                "{}: is or holds the input {}, which writing the outputs there would delete; choose another output folder",
                 dest.display(),
                 input.display()
             );

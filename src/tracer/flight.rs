@@ -15,6 +15,7 @@
 
 use crate::estimator::Estimator;
 use crate::optics::medium::Medium;
+use crate::optics::spectrum::Light;
 use crate::rng::PhotonRng;
 use crate::tally::{ExactSum, Ledger};
 use glam::DVec3;
@@ -35,7 +36,7 @@ pub(super) enum Flight {
     },
 }
 
-/// Fly a photon of `weight` along unit `dir` through scattering `medium` towards an
+/// Fly a photon of `weight` and light `light` along unit `dir` through scattering `medium` towards an
 /// event at `t_next` (infinite when nothing is ahead); `absorbed` is the medium's
 /// ledger entry. A scattering point is kept at least `eps` (the scene's spawn offset)
 /// from both ends of the segment, so the next search starts clear of the surfaces it
@@ -45,13 +46,14 @@ pub(super) fn fly(
     medium: &Medium,
     estimator: Estimator,
     weight: &mut f64,
+    light: Light,
     dir: DVec3,
     t_next: f64,
     eps: f64,
     rng: &mut PhotonRng,
     absorbed: &mut ExactSum,
 ) -> Flight {
-    let (mu_a, mu_s) = (medium.absorption_per_mm, medium.scattering.per_mm);
+    let (mu_a, mu_s) = (medium.absorption(light), medium.scattering.per_mm);
     let path = |rng: &mut PhotonRng, mu: f64| -(1.0 - rng.uniform()).ln() / mu;
     let t = match estimator {
         Estimator::Analog => {

@@ -31,6 +31,8 @@ use crate::optics::dots::DotPattern;
 use crate::optics::fresnel;
 use crate::optics::lambert;
 use crate::optics::medium::{Interface, MediumId};
+use crate::optics::model::Arrival;
+use crate::optics::spectrum::{Light, Spectral};
 use crate::optics::surface::{Feature, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
@@ -48,7 +50,7 @@ pub(super) enum Face<'a> {
         smooth: Smooth,
         pattern: &'a DotPattern,
         radii: Option<ColumnRadii>,
-        ink_albedo: f64,
+        ink_albedo: Spectral,
     },
     /// Any other model, through [`SurfaceModel::interact_on`].
     Other,
@@ -58,8 +60,8 @@ pub(super) enum Face<'a> {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Smooth {
     iface: Interface,
-    n_inside: f64,
-    n_outside: f64,
+    n_inside: Spectral,
+    n_outside: Spectral,
 }
 
 /// What the walk needs of a scene: each tag's face and, per medium, the solid to walk.
@@ -121,7 +123,7 @@ impl Tracer<'_> {
         events: &mut u32,
     ) -> Option<Fate> {
         let scene = self.scene;
-        let (medium, absorption) = (p.medium, scene.media[p.medium as usize].absorption_per_mm);
+        let (medium, absorption) = (p.medium, scene.media[p.medium as usize].absorption(p.light));
         let mut ray = p.ray.true_ray();
         while *events < scene.max_bounces {
             *events += 1;
@@ -142,7 +144,7 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: facet.normal,
             };
-            let (outcome, feature) = self.face_step(tag, &surf, ray.dir, medium, rng);
+            let (outcome, feature) = self.face_step(tag, &surf, ray.dir, medium, p.light, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
             let Outcome::Scattered {
                 dir,
@@ -175,12 +177,13 @@ impl Tracer<'_> {
         surf: &SurfaceHit,
         dir: DVec3,
         medium: MediumId,
+        light: Light,
         rng: &mut PhotonRng,
     ) -> (Outcome, Feature) {
         // As interact_on and dielectric::scatter decide it (NaN counts as leaving).
         let entering = dir.dot(surf.normal) < 0.0;
         match &self.walks.faces[tag as usize] {
-            Face::Smooth(s) if !entering => (s.leave(surf.normal, dir, rng), Feature::Plain),
+            Face::Smooth(s) if !entering => (s.leave(surf.normal, dir, light, rng), Feature::Plain),
             Face::Dotted {
                 smooth,
                 pattern,
@@ -192,19 +195,23 @@ impl Tracer<'_> {
                     None => pattern.meets_ink(surf.point, rng),
                 };
                 if ink_met {
-                    let outcome = ink(*ink_albedo, -surf.normal, medium, self.estimator, rng);
+                    let albedo = ink_albedo.at(light);
+                    let outcome = ink(albedo, -surf.normal, medium, self.estimator, rng);
                     return (outcome, Feature::Ink);
                 }
-                (smooth.leave(surf.normal, dir, rng), Feature::Plain)
+                (smooth.leave(surf.normal, dir, light, rng), Feature::Plain)
             }
-            _ => self.scene.surfaces[tag as usize].interact_on(
-                &self.scene.media,
-                surf,
-                dir,
-                medium,
-                self.estimator,
-                rng,
-            ),
+            _ => {
+                let at = Arrival {
+                    media: &self.scene.media,
+                    hit: surf,
+                    dir,
+                    medium,
+                    est: self.estimator,
+                    light,
+                };
+                self.scene.surfaces[tag as usize].interact_on(&at, rng)
+            }
         }
     }
 }
@@ -214,10 +221,10 @@ impl Smooth {
     /// against the outward `normal`): Fresnel roulette from inside to outside.
     // Always inlined: see the module header (store forwarding).
     #[inline(always)]
-    fn leave(&self, normal: DVec3, dir: DVec3, rng: &mut PhotonRng) -> Outcome {
+    fn leave(&self, normal: DVec3, dir: DVec3, light: Light, rng: &mut PhotonRng) -> Outcome {
         let facing = -normal;
-        let (dir, medium) = match fresnel::roulette(dir, facing, self.n_inside, self.n_outside, rng)
-        {
+        let (n1, n2) = (self.n_inside.at(light), self.n_outside.at(light));
+        let (dir, medium) = match fresnel::roulette(dir, facing, n1, n2, rng) {
             Some(t) => (t, self.iface.outside),
             None => (fresnel::reflect(dir, facing), self.iface.inside),
         };

@@ -191,7 +191,7 @@ impl std::fmt::Display for LayoutEvaluation {
             self.efficiency_stderr
         )?;
         if self.below_noise_floor() {
-            f.write_str("  [cv below its noise floor: use more --photons]")?;
+            f.write_str("  [cv below its noise floor: trace more photons]")?;
         }
         Ok(())
     }

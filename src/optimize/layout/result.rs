@@ -2,6 +2,7 @@
 
 use super::objective::LayoutEvaluation;
 use super::search::{EvaluationRecord, LayoutSearch};
+use crate::optimize::design::Design;
 
 use crate::optimize::{Method, OptimizeOptions};
 use crate::run::RunResult;
@@ -142,7 +143,7 @@ pub(super) fn finish(
     } else {
         let run_options = options.verification_run();
         let verify = |x: &[f64]| -> Result<(RunResult, VerifiedLayout)> {
-            let (run, evaluation) = search.trace(search.design(x)?, &run_options)?;
+            let (run, evaluation) = search.trace(x, &run_options)?;
             let summary = run.summary();
             Ok((
                 run,

@@ -4,7 +4,7 @@
 use super::objective::{LayoutEvaluation, ObjectiveSpec};
 use super::vary::Variable;
 use crate::optimize::OptimizeOptions;
-use crate::optimize::traced;
+use crate::optimize::design::Design;
 use crate::run::RunResult;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
@@ -91,25 +91,6 @@ impl<'a> LayoutSearch<'a> {
         doc
     }
 
-    /// The design `x` as a loaded scene, or why it does not load.
-    pub(super) fn design(&self, x: &[f64]) -> Result<Scene> {
-        let file: SceneFile = self
-            .document(x)
-            .try_into()
-            .map_err(|e| anyhow::anyhow!("{}: {e}", self.scene.path.display()))?;
-        Scene::from_file_reading(&file, &self.scene.path, &self.reads)
-    }
-
-    /// Trace the design `x` with `run_options` and judge it.
-    pub(super) fn trace(
-        &self,
-        scene: Scene,
-        run_options: &RunOptions,
-    ) -> Result<(RunResult, LayoutEvaluation)> {
-        let builds = &mut self.builds.borrow_mut();
-        traced::trace_judged(scene, run_options, builds, |r| self.objective.evaluate(r))
-    }
-
     /// Evaluate the design `x` (inside the bounds): its objective and standard error, or
     /// the penalty when the scene does not load. Keeps the best; `progress` sees the record.
     pub(super) fn evaluate(
@@ -121,9 +102,9 @@ impl<'a> LayoutSearch<'a> {
         if let Some(&seen) = self.seen.get(&key) {
             return Ok(seen);
         }
-        let (result, rejected, value) = match self.design(x) {
+        let (result, rejected, value) = match self.scene(x) {
             Ok(scene) => {
-                let (run, ev) = self.trace(scene, &self.run_options.clone())?;
+                let (run, ev) = self.trace_scene(scene, &self.run_options.clone())?;
                 self.photons += ev.photons;
                 let value = ev.objective;
                 if self
@@ -169,5 +150,28 @@ impl<'a> LayoutSearch<'a> {
         };
         progress(&r, &self.names());
         self.history.push(r);
+    }
+}
+
+/// A layout design: the scene file with the varied keys set to the point's values,
+/// loaded (reusing the geometry files as first read), judged by the `--objective`.
+impl Design for LayoutSearch<'_> {
+    type Point = [f64];
+    type Judged = LayoutEvaluation;
+
+    fn scene(&self, x: &[f64]) -> Result<Scene> {
+        let file: SceneFile = self
+            .document(x)
+            .try_into()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", self.scene.path.display()))?;
+        Scene::from_file_reading(&file, &self.scene.path, &self.reads)
+    }
+
+    fn judge(&self, run: &RunResult) -> Result<LayoutEvaluation> {
+        Ok(self.objective.evaluate(run))
+    }
+
+    fn builds(&self) -> &RefCell<MeshBuildCache> {
+        &self.builds
     }
 }

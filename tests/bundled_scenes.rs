@@ -13,6 +13,7 @@ use blutrace::geometry::{Ray, intersect_triangle};
 use blutrace::scene::Scene;
 use blutrace::scene::config::{ProceduralSpec, SceneFile};
 use blutrace::sources::Emitter;
+use blutrace::sources::ccfl::Tube;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -223,12 +224,12 @@ fn lamps_are_clear_of_all_surfaces_and_enclosed() {
             })
             .collect();
         for s in &scene.sources.list {
-            let Emitter::Ccfl {
+            let Emitter::Ccfl(Tube {
                 center,
                 axis,
                 radius,
                 length,
-            } = s.emitter
+            }) = s.emitter
             else {
                 continue;
             };

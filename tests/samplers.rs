@@ -16,6 +16,7 @@ use blutrace::optics::phong::Phong;
 use blutrace::optics::sampling;
 use blutrace::rng::PhotonRng;
 use blutrace::sources::intensity::IntensityProfile;
+use blutrace::sources::led::{FlatLed, LedProfile};
 use blutrace::sources::{Emitter, Source};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
@@ -349,14 +350,14 @@ fn measured_led_directions_follow_the_intensity_profile() {
             name: what.into(),
             power_w: 1.0,
             lumens: None,
-            emitter: Emitter::MeasuredLed {
+            emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal,
                 u,
                 width: 2.0,
                 height: 1.0,
-                profile: profile.clone(),
-            },
+                profile: LedProfile::Measured(profile.clone()),
+            }),
             medium: 0,
             body: None,
         };

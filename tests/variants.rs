@@ -12,6 +12,7 @@ use blutrace::scene::Scene;
 use blutrace::scene::config::{SceneFile, SourceSpec};
 use blutrace::sources::Emitter;
 use blutrace::sources::intensity::IntensityProfile;
+use blutrace::sources::led::LedProfile;
 use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 use support::*;
@@ -180,9 +181,9 @@ fn csv_and_ies_files_of_one_profile_trace_identically() {
     let path = scene_path("phone-led/scene.toml");
     let mut file: SceneFile = toml::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     for s in &mut file.sources {
-        if let SourceSpec::Led { intensity_file, .. } = s {
-            assert_eq!(intensity_file.as_deref(), Some(Path::new("led.ies")));
-            *intensity_file = Some("led.csv".into());
+        if let SourceSpec::Led(led) = s {
+            assert_eq!(led.intensity_file.as_deref(), Some(Path::new("led.ies")));
+            led.intensity_file = Some("led.csv".into());
         }
     }
     let with_csv = Scene::from_file(&file, &path).unwrap();
@@ -273,7 +274,7 @@ fn phone_led_shows_hot_spots_and_dark_corners() {
             .sources
             .list
             .iter()
-            .all(|s| matches!(s.emitter, Emitter::MeasuredLed { .. }))
+            .all(|s| matches!(&s.emitter, Emitter::Led(led) if matches!(led.profile, LedProfile::Measured(_))))
     );
     let r = trace(&scene, 200_000, 1, 2);
     assert_balanced(&r);

@@ -48,9 +48,9 @@ else
   mapfile -t targets < <("${fuzz[@]}" list)
 fi
 # Build once, then run the binaries: a run fuzzes the library as it was at the start,
-# even if src/ is edited meanwhile (cargo fuzz run would rebuild before every target).
+# even if crates/blutrace/src/ is edited meanwhile (cargo fuzz run would rebuild before every target).
 if ! "${fuzz[@]}" build -s none; then
-  echo "tools/fuzz.sh: the build failed (src/ being edited? retry in a minute)" >&2
+  echo "tools/fuzz.sh: the build failed (crates/blutrace/src/ being edited? retry in a minute)" >&2
   exit 2
 fi
 bin=target/$(rustc +nightly -vV | sed -n 's/^host: //p')/release

@@ -41,7 +41,7 @@ pub(super) fn bench(
     threads: Option<usize>,
     repeat: usize,
 ) -> Result<()> {
-    let rows = blutrace::bench::reference_table(box_scene, photons, threads, repeat)?;
+    let rows = blutrace_bench::reference_table(box_scene, photons, threads, repeat)?;
     say!(
         "| {}, {photons} photons | photons/s | interactions/s | ratio to the reference |",
         box_scene.display()
@@ -62,7 +62,7 @@ pub(super) fn bench(
         "| scene | triangles | backend | convex path | photons/s | interactions/s | ratio to obvhs |"
     );
     say!("|---|---:|---|---|---:|---:|---:|");
-    let traced = blutrace::bench::trace_table(scene, photons, threads, repeat)?;
+    let traced = blutrace_bench::trace_table(scene, photons, threads, repeat)?;
     for r in &traced {
         say!(
             "| {} | {} | {} | {} | {:.0} | {:.0} | {:.2} |",
@@ -78,7 +78,7 @@ pub(super) fn bench(
     say!();
     reader_still_there()?;
     print_load(scene, &traced, repeat)?;
-    let table = blutrace::bench::in_guide_table(scene, 1_000_000, repeat)?;
+    let table = blutrace_bench::in_guide_table(scene, 1_000_000, repeat)?;
     let convex = table.last().map_or(f64::NAN, |(_, q)| *q);
     say!("| in-guide nearest-hit queries (1 thread) | queries/s | convex path speed-up |");
     say!("|---|---:|---:|");
@@ -87,7 +87,7 @@ pub(super) fn bench(
     }
     say!();
     reader_still_there()?;
-    let large = blutrace::bench::large_mesh_table(scene, 1_000_000, repeat)?;
+    let large = blutrace_bench::large_mesh_table(scene, 1_000_000, repeat)?;
     if let Some(native) = large.native_packets {
         say!(
             "Embree packet widths on this machine: {native} (RTC_DEVICE_PROPERTY_NATIVE_RAY*_SUPPORTED)"
@@ -111,7 +111,7 @@ pub(super) fn bench(
     }
     say!();
     reader_still_there()?;
-    let rows = blutrace::bench::error_table(scene, 4.0, threads)?;
+    let rows = blutrace_bench::error_table(scene, 4.0, threads)?;
     say!(
         "| backend | estimator | photons in ~4 s | mean-flux error | per-bin error | FOM mean | FOM bins |"
     );
@@ -133,8 +133,8 @@ pub(super) fn bench(
 
 /// The large mesh's load time, and the photons the fastest configuration of the trace
 /// table traces on that mesh in the same time.
-fn print_load(scene: &Path, traced: &[blutrace::bench::BenchRow], repeat: usize) -> Result<()> {
-    let load = blutrace::bench::large_load_row(scene, repeat)?;
+fn print_load(scene: &Path, traced: &[blutrace_bench::BenchRow], repeat: usize) -> Result<()> {
+    let load = blutrace_bench::large_load_row(scene, repeat)?;
     let Some(fastest) = traced
         .iter()
         .filter(|r| r.triangles == load.triangles)

@@ -1,0 +1,266 @@
+//! The fictitious target plane: a regular grid of flux bins plus an angular histogram.
+//!
+//! ```toml
+//! [detector]
+//! origin = [0.0, 0.0, 2.5]   # a corner of the target rectangle (mm)
+//! u = [1.0, 0.0, 0.0]        # first in-plane axis (grid x)
+//! v = [0.0, 1.0, 0.0]        # second in-plane axis (grid y); normal = u x v
+//! size_mm = [300.0, 200.0]
+//! bins = [100, 100]
+//! angular_bins = [18, 36]    # theta over [0, 90] deg from the normal, phi over [0, 360)
+//! ```
+//!
+//! A photon crossing the rectangle along the normal (from the back, towards the viewer)
+//! is detected and stops there; one crossing the other way passes through.
+
+use crate::geometry::Ray;
+use crate::spec_check::Ctx;
+use anyhow::Result;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+/// `[detector]`: the target plane as the scene file gives it.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DetectorSpec {
+    /// A corner of the rectangle.
+    pub origin: [f64; 3],
+    /// Grid-x axis.
+    pub u: [f64; 3],
+    /// Grid-y axis.
+    pub v: [f64; 3],
+    /// Width and height (mm).
+    pub size_mm: [f64; 2],
+    /// Flux bins.
+    #[serde(default = "default_bins")]
+    pub bins: [usize; 2],
+    /// Angular bins (theta, phi).
+    #[serde(default = "default_angular_bins")]
+    pub angular_bins: [usize; 2],
+}
+
+fn default_bins() -> [usize; 2] {
+    [100, 100]
+}
+
+fn default_angular_bins() -> [usize; 2] {
+    [18, 36]
+}
+
+impl DetectorSpec {
+    /// Check `[detector]` and build the target plane.
+    pub fn build(&self, ctx: &Ctx) -> Result<TargetPlane> {
+        let d = self;
+        let u = ctx.direction("detector.u", d.u)?;
+        let v = ctx.direction("detector.v", d.v)?;
+        if u.dot(v).abs() > 1e-6 {
+            return Err(ctx.err("detector.v", "must be perpendicular to detector.u"));
+        }
+        for (k, n) in d.bins.iter().chain(&d.angular_bins).enumerate() {
+            let field = if k < 2 {
+                "detector.bins"
+            } else {
+                "detector.angular_bins"
+            };
+            if *n == 0 || *n > 100_000 {
+                return Err(ctx.err(
+                    field,
+                    format!("bin counts must be within 1..=100000, got {n}"),
+                ));
+            }
+        }
+        Ok(TargetPlane {
+            origin: ctx.point("detector.origin", d.origin)?,
+            u,
+            v,
+            size: [
+                ctx.length("detector.size_mm[0]", d.size_mm[0])?,
+                ctx.length("detector.size_mm[1]", d.size_mm[1])?,
+            ],
+            bins: d.bins,
+            angular_bins: d.angular_bins,
+        })
+    }
+}
+
+/// The target plane and its binning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetPlane {
+    /// A corner of the rectangle.
+    pub origin: DVec3,
+    /// Unit grid-x axis.
+    pub u: DVec3,
+    /// Unit grid-y axis (orthogonal to `u`).
+    pub v: DVec3,
+    /// Width and height (mm).
+    pub size: [f64; 2],
+    /// Flux bins along u and v.
+    pub bins: [usize; 2],
+    /// Angular bins: theta (0..90 deg) and phi (0..360 deg).
+    pub angular_bins: [usize; 2],
+}
+
+impl TargetPlane {
+    /// Unit normal: the direction photons are detected travelling along.
+    pub fn normal(&self) -> DVec3 {
+        self.u.cross(self.v)
+    }
+
+    /// Size of one flux bin along u and v (mm).
+    pub fn bin_size(&self) -> [f64; 2] {
+        [
+            self.size[0] / self.bins[0] as f64,
+            self.size[1] / self.bins[1] as f64,
+        ]
+    }
+
+    /// Area of one flux bin (mm^2).
+    pub fn bin_area(&self) -> f64 {
+        let [bx, by] = self.bin_size();
+        bx * by
+    }
+
+    /// Area of the target rectangle (m^2).
+    pub fn area_m2(&self) -> f64 {
+        self.size[0] * self.size[1] * 1e-6
+    }
+
+    /// Centre of bin `(ix, iy)` of an `nx` x `ny` grid over the target (the detector's
+    /// own flux bins, or a map of another resolution).
+    pub fn grid_centre(&self, [nx, ny]: [usize; 2], ix: usize, iy: usize) -> DVec3 {
+        let (bx, by) = (self.size[0] / nx as f64, self.size[1] / ny as f64);
+        self.origin + self.u * ((ix as f64 + 0.5) * bx) + self.v * ((iy as f64 + 0.5) * by)
+    }
+
+    /// Flux bins along the in-plane axis (u or v) closer to `axis`.
+    pub fn bins_along(&self, axis: DVec3) -> usize {
+        if self.u.dot(axis).abs() >= self.v.dot(axis).abs() {
+            self.bins[0]
+        } else {
+            self.bins[1]
+        }
+    }
+
+    /// Where `ray` crosses the rectangle forwards, nearer than `tmax`: distance and
+    /// in-plane coordinates (mm).
+    pub fn intersect(&self, ray: &Ray, tmax: f64) -> Option<(f64, [f64; 2])> {
+        let n = self.normal();
+        let denom = ray.dir.dot(n);
+        if denom <= 0.0 {
+            return None;
+        }
+        let t = (self.origin - ray.origin).dot(n) / denom;
+        if !(t > 0.0 && t < tmax) {
+            return None;
+        }
+        let r = ray.at(t) - self.origin;
+        let (a, b) = (r.dot(self.u), r.dot(self.v));
+        let inside = (0.0..self.size[0]).contains(&a) && (0.0..self.size[1]).contains(&b);
+        inside.then_some((t, [a, b]))
+    }
+
+    /// The flux bin holding in-plane coordinates `ab`.
+    pub fn flux_bin(&self, ab: [f64; 2]) -> (usize, usize) {
+        let f = |k: usize| {
+            let i = (ab[k] / self.size[k] * self.bins[k] as f64) as usize;
+            i.min(self.bins[k] - 1)
+        };
+        (f(0), f(1))
+    }
+
+    /// Index of the flux bin holding `ab` in the flux grid (row-major, x fastest).
+    pub fn flux_index(&self, ab: [f64; 2]) -> usize {
+        let (ix, iy) = self.flux_bin(ab);
+        iy * self.bins[0] + ix
+    }
+
+    /// Index of the angular bin of `dir` in the angular grid (theta fastest).
+    pub fn angular_index(&self, dir: DVec3) -> usize {
+        let (it, ip) = self.angular_bin(dir);
+        ip * self.angular_bins[0] + it
+    }
+
+    /// Angular bin widths (degrees): theta, phi.
+    pub fn angular_bin_deg(&self) -> [f64; 2] {
+        let [nt, np] = self.angular_bins;
+        [90.0 / nt as f64, 360.0 / np as f64]
+    }
+
+    /// Polar angle (degrees) at the centre of angular bin row `it`.
+    pub fn theta_centre_deg(&self, it: usize) -> f64 {
+        90.0 * (it as f64 + 0.5) / self.angular_bins[0] as f64
+    }
+
+    /// The (theta, phi) bin of a detected direction.
+    pub fn angular_bin(&self, dir: DVec3) -> (usize, usize) {
+        let (theta, phi) = self.angles(dir);
+        let [nt, np] = self.angular_bins;
+        let it = ((theta / FRAC_PI_2) * nt as f64) as usize;
+        let ip = ((phi / TAU) * np as f64) as usize;
+        (it.min(nt - 1), ip.min(np - 1))
+    }
+
+    /// Polar angle from the normal and azimuth from `u` towards `v` (radians).
+    pub fn angles(&self, dir: DVec3) -> (f64, f64) {
+        let theta = dir.dot(self.normal()).clamp(-1.0, 1.0).acos();
+        let phi = dir.dot(self.v).atan2(dir.dot(self.u)).rem_euclid(TAU);
+        (theta, phi)
+    }
+
+    /// Solid angle (sr) of angular bin row `it` (every phi bin in it has the same).
+    pub fn angular_bin_solid_angle(&self, it: usize) -> f64 {
+        let [nt, np] = self.angular_bins;
+        let t0 = FRAC_PI_2 * it as f64 / nt as f64;
+        let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
+        (t0.cos() - t1.cos()) * TAU / np as f64
+    }
+
+    /// Projected solid angle (sr, the integral of cos theta) of one bin in row `it`.
+    pub fn angular_bin_projected_solid_angle(&self, it: usize) -> f64 {
+        let [nt, np] = self.angular_bins;
+        let t0 = FRAC_PI_2 * it as f64 / nt as f64;
+        let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
+        0.5 * (t1.sin().powi(2) - t0.sin().powi(2)) * TAU / np as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane() -> TargetPlane {
+        TargetPlane {
+            origin: DVec3::ZERO,
+            u: DVec3::X,
+            v: DVec3::Y,
+            size: [10.0, 5.0],
+            bins: [10, 5],
+            angular_bins: [9, 12],
+        }
+    }
+
+    #[test]
+    fn detects_forward_crossings_only() {
+        let p = plane();
+        let up = Ray::new(DVec3::new(2.5, 1.5, -1.0), DVec3::Z);
+        let (t, ab) = p.intersect(&up, 10.0).unwrap();
+        assert_eq!(t, 1.0);
+        assert_eq!(p.flux_bin(ab), (2, 1));
+        let down = Ray::new(DVec3::new(2.5, 1.5, 1.0), DVec3::NEG_Z);
+        assert!(p.intersect(&down, 10.0).is_none());
+        let outside = Ray::new(DVec3::new(12.0, 1.5, -1.0), DVec3::Z);
+        assert!(p.intersect(&outside, 10.0).is_none());
+    }
+
+    #[test]
+    fn angular_solid_angles_cover_hemisphere() {
+        let p = plane();
+        let total: f64 = (0..9).map(|it| p.angular_bin_solid_angle(it) * 12.0).sum();
+        assert!((total - TAU).abs() < 1e-12);
+        let projected: f64 = (0..9)
+            .map(|it| p.angular_bin_projected_solid_angle(it) * 12.0)
+            .sum();
+        assert!((projected - std::f64::consts::PI).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,171 @@
+//! `optimized.toml`: the original scene file with the final density, edited as the typed
+//! [`SceneFile`] and written by the `toml` crate (keys in alphabetical order):
+//!
+//! ```toml
+//! name = "notebook14-optimized"   # the original name with -optimized
+//!
+//! [[geometry]]
+//! file = "/abs/path/notebook14.obj"   # file paths made absolute
+//!
+//! [surfaces.lgp_back]
+//! model = "dots"
+//! density_table = [[0.01, 0.013], ...]   # or density = [...] or density_grid = {...}
+//! ```
+//!
+//! Keys the original left at their defaults are written out with their values.
+
+use super::OptimizeResult;
+use crate::optics::dots::Density;
+use crate::scene::config::{SceneFile, SourceSpec, SurfaceSpec};
+use anyhow::{Context, Result, bail};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+impl OptimizeResult {
+    /// The scene file of the final design: the original with the new density, geometry
+    /// and other file paths made absolute, so it traces from anywhere.
+    pub fn optimized_toml(&self) -> Result<String> {
+        let path = &self.scene_file;
+        // The file as the scene was loaded from it (not read again: it may have changed).
+        let mut file = self.initial_run.scene.file();
+        let base = path.parent().unwrap_or(Path::new("."));
+        make_paths_absolute(&mut file, path, base)?;
+        let surface = file
+            .surfaces
+            .get_mut(&self.tag)
+            .with_context(|| format!("{}: no [surfaces.{}]", path.display(), self.tag))?;
+        set_density(surface, &self.final_density)
+            .with_context(|| format!("{}: [surfaces.{}]", path.display(), self.tag))?;
+        let name = file.name.clone().unwrap_or_else(|| {
+            base.file_name()
+                .map_or("scene".into(), |n| n.to_string_lossy().into_owned())
+        });
+        file.name = Some(format!("{name}-optimized"));
+        let body = to_toml(&file)?;
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "# Written by `blutrace optimize --method {}` from {}.\n# Only [surfaces.{}] density changed; file paths are absolute.\n",
+            self.method,
+            path.display(),
+            self.tag
+        );
+        out.push_str(&body);
+        Ok(out)
+    }
+}
+
+/// `file` as TOML. Through a `toml::Value`, whose tables sort their keys: the sections
+/// and keys come out in alphabetical order, not in the structs' field order.
+pub(super) fn to_toml(file: &SceneFile) -> Result<String> {
+    let value = toml::Value::try_from(file).context("cannot write the optimized scene")?;
+    toml::to_string(&value).context("cannot write the optimized scene as TOML")
+}
+
+/// The scene file at `path`, parsed.
+#[cfg(test)]
+fn read_scene_file(path: &Path) -> Result<SceneFile> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read scene file", path.display()))?;
+    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Make the geometry files and the sources' intensity files absolute (they are relative
+/// to `base`, the folder of the scene file `path`).
+pub(super) fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result<()> {
+    let absolute = |p: &mut PathBuf| -> Result<()> {
+        let joined = base.join(&*p);
+        let found = joined
+            .canonicalize()
+            .with_context(|| format!("{}: cannot find {}", path.display(), joined.display()))?;
+        *p = PathBuf::from(found.to_string_lossy().into_owned());
+        Ok(())
+    };
+    for g in &mut file.geometry {
+        absolute(&mut g.file)?;
+    }
+    for s in &mut file.sources {
+        if let SourceSpec::Led(led) = s
+            && let Some(f) = &mut led.intensity_file
+        {
+            absolute(f)?;
+        }
+    }
+    Ok(())
+}
+
+/// Replace the density of the dots surface `spec` by `density`.
+fn set_density(spec: &mut SurfaceSpec, density: &Density) -> Result<()> {
+    let SurfaceSpec::Dots(dots) = spec else {
+        bail!("not a model = \"dots\" surface");
+    };
+    dots.set_density(density);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::dots::DensityGrid;
+
+    /// A scene file as JSON, to compare two of them.
+    fn json(file: &SceneFile) -> serde_json::Value {
+        serde_json::to_value(file).unwrap()
+    }
+
+    #[test]
+    fn every_bundled_scene_survives_the_round_trip() {
+        let scenes = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
+        let mut n = 0;
+        for entry in std::fs::read_dir(&scenes).unwrap() {
+            let path = entry.unwrap().path().join("scene.toml");
+            if !path.exists() {
+                continue;
+            }
+            let file = read_scene_file(&path).unwrap();
+            let again: SceneFile = toml::from_str(&to_toml(&file).unwrap()).unwrap();
+            assert_eq!(json(&file), json(&again), "{}", path.display());
+            n += 1;
+        }
+        assert!(n > 0, "no scenes under {}", scenes.display());
+    }
+
+    #[test]
+    fn the_density_is_replaced_and_the_paths_made_absolute() {
+        let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .join("scenes/notebook14/scene.toml");
+        let mut file = read_scene_file(&path).unwrap();
+        make_paths_absolute(&mut file, &path, path.parent().unwrap()).unwrap();
+        assert!(file.geometry.iter().all(|g| g.file.is_absolute()));
+        let spec = file.surfaces.get_mut("lgp_back").unwrap();
+        let grid = DensityGrid {
+            x_max: 1.0,
+            v_min: -2.0,
+            width: 4.0,
+            values: vec![vec![0.1, 0.2], vec![0.3, 0.4]],
+        };
+        for density in [
+            Density::Table(vec![[0.0, 0.1], [1.0, 0.3]]),
+            Density::Grid(grid),
+            Density::Polynomial(vec![0.1, 0.05]),
+        ] {
+            set_density(spec, &density).unwrap();
+            let text = toml::to_string(&toml::Value::try_from(&*spec).unwrap()).unwrap();
+            let keys = ["density =", "density_table", "density_grid"];
+            let present: Vec<_> = keys.iter().filter(|k| text.contains(*k)).collect();
+            assert_eq!(present.len(), 1, "{text}");
+            // The same density comes back from the TOML (a grid's x_max is the
+            // pattern's, not the file's).
+            let SurfaceSpec::Dots(back) = toml::from_str::<SurfaceSpec>(&text).unwrap() else {
+                panic!("{text}");
+            };
+            let ctx = crate::spec_check::Ctx(&path);
+            let x_max = 1.0;
+            let (again, _) =
+                Density::from_keys(&ctx, "s", back.density_keys(), None, x_max).unwrap();
+            assert_eq!(again, density, "{text}");
+        }
+        let mut other = file.surfaces.get("lgp_front").unwrap().clone();
+        assert!(set_density(&mut other, &Density::Polynomial(vec![0.1])).is_err());
+    }
+}

@@ -1,0 +1,492 @@
+//! The photon loop (paper section 3), traced in fixed chunks of photons (the rounds that
+//! run them in parallel are `run::rounds`).
+//!
+//! ```toml
+//! [trace]
+//! photons = 400000       # default photon count (CLI --photons overrides)
+//! seed = 1               # default seed (CLI --seed overrides)
+//! max_bounces = 100000   # events before a photon is killed (counted, not silent)
+//! ```
+//!
+//! Each photon is traced along straight segments to the nearest surface, where its
+//! surface model decides by Russian roulette to reflect, transmit or absorb it; inside a
+//! scattering medium a segment may end earlier in a scattering event (`flight`). Both
+//! kinds of event count as interactions and towards `max_bounces`. It ends in
+//! exactly one fate: detected, absorbed (by a named surface or medium), escaped, killed
+//! by the bounce cap, or (weighted estimator only) ended by Russian roulette. Work is split
+//! into fixed chunks of photon indices; tallies are exact integer sums, so the result does
+//! not depend on the thread count.
+
+mod body_boxes;
+mod flight;
+mod solid_walk;
+
+use crate::accel::Accel;
+use crate::accel::convex::ConvexSolid;
+use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
+use crate::optics::absorber::Absorber;
+use crate::optics::model::Arrival;
+use crate::optics::spectrum::Light;
+use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
+use crate::rng::PhotonRng;
+use crate::scene::Scene;
+use crate::sources::body::LampBody;
+use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
+use body_boxes::BodyBoxes;
+use flight::Flight;
+use solid_walk::Walks;
+
+/// The convex solid of `medium` when the convex path is on and the medium has one.
+fn convex_solid(scene: &Scene, convex: bool, medium: MediumId) -> Option<&ConvexSolid> {
+    scene.convex_solid(medium).filter(|_| convex)
+}
+
+/// Photons per work unit. Fixed, so results never depend on scheduling.
+pub const CHUNK: u64 = 4096;
+
+/// Weighted estimator: below this weight a photon plays Russian roulette...
+const ROULETTE_BELOW: f64 = 0.1;
+/// ...and survives with probability `w / ROULETTE_SURVIVOR`, then carries this weight.
+const ROULETTE_SURVIVOR: f64 = 0.5;
+
+/// Traces photons of one scene through one backend (built by [`Tracer::new`], which
+/// derives the walks from the other fields, so they are fixed after it).
+pub struct Tracer<'a> {
+    /// The scene.
+    scene: &'a Scene,
+    /// The intersection backend.
+    accel: &'a dyn Accel,
+    /// How absorption is sampled.
+    estimator: Estimator,
+    /// Use the convex-solid fast path inside convex media.
+    convex: bool,
+    /// Every triangle of the scene's mesh as a hit on it reads it
+    /// ([`crate::geometry::Mesh::facets`]).
+    facets: &'a [Facet],
+    /// Where photons go face to face inside a convex solid ([`solid_walk`]).
+    walks: Walks<'a>,
+    /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
+    bodies: BodyBoxes,
+}
+
+/// A photon in flight.
+struct Photon {
+    /// Where it is and where it goes (nudged off the surface it last left).
+    ray: SpawnedRay,
+    medium: MediumId,
+    weight: f64,
+    /// Its light, drawn with its emission: what it meets is read at it.
+    light: Light,
+    /// Analog estimator: the optical depth of clear-medium absorption the photon has
+    /// left (an Exp(1) draw, made on its first absorbing segment; negative until then).
+    absorption_depth: f64,
+}
+
+impl Photon {
+    /// Scale the weight by `factor` (a surface's albedo under the weighted estimator),
+    /// booking the loss to `sink`.
+    fn reweigh(&mut self, factor: f64, sink: &mut ExactSum) {
+        let w = self.weight * factor;
+        Ledger::lose(sink, self.weight, w);
+        self.weight = w;
+    }
+}
+
+impl<'a> Tracer<'a> {
+    /// A tracer of `scene` through `accel`, with the mesh's `facets`
+    /// ([`crate::geometry::Mesh::facets`]); `convex` turns the convex-solid fast path on.
+    pub fn new(
+        scene: &'a Scene,
+        accel: &'a dyn Accel,
+        estimator: Estimator,
+        convex: bool,
+        facets: &'a [Facet],
+    ) -> Tracer<'a> {
+        let bodies = BodyBoxes::new(scene);
+        Tracer {
+            scene,
+            accel,
+            estimator,
+            convex,
+            facets,
+            walks: Walks::new(scene, convex, &bodies),
+            bodies,
+        }
+    }
+
+    /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
+    fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
+        let mut rng = PhotonRng::new(seed, index);
+        let e = self.scene.sources.sample(&mut rng);
+        let mut p = Photon {
+            ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
+            medium: e.medium,
+            weight: 1.0,
+            light: e.light,
+            absorption_depth: -1.0,
+        };
+        out.ledger.photons += 1;
+        out.ledger.emitted.add(1.0);
+        let fate = self.follow(&mut p, &mut rng, out);
+        out.ledger.end(fate, p.weight);
+    }
+
+    /// The photon loop: nearest event, the medium on the way, surface roulette, repeat;
+    /// inside a walkable convex solid, face to face ([`solid_walk`]).
+    fn follow(&self, p: &mut Photon, rng: &mut PhotonRng, out: &mut ChunkTally) -> Fate {
+        let scene = self.scene;
+        let mut events = 0;
+        while events < scene.max_bounces {
+            if let Some(solid) = self.walks.solid(p.medium) {
+                match self.walk_solid(solid, p, rng, out, &mut events) {
+                    Some(fate) => return fate,
+                    None => continue,
+                }
+            }
+            events += 1;
+            let true_ray = p.ray.true_ray();
+            let surf = self.nearest_surface(p, &true_ray);
+            let t_surface = surf.map_or(f64::INFINITY, |h| h.surf.t);
+            let detected = self.target_hit(p, &true_ray, t_surface);
+            let t_next = detected.map_or(t_surface, |(t, _)| t);
+            match self.cross_medium(p, &true_ray, t_next, rng, &mut out.ledger) {
+                Flight::Absorbed => return Fate::AbsorbedInMedium(p.medium),
+                Flight::Scattered { .. } => {
+                    out.ledger.interactions += 1;
+                    if !roulette(p, rng, &mut out.ledger) {
+                        return Fate::Roulette;
+                    }
+                    continue;
+                }
+                Flight::Reached => {}
+            }
+            if let Some((_, ab)) = detected {
+                let weight = p.light.detected(p.weight);
+                out.detections
+                    .push(detection(scene, ab, true_ray.dir, weight));
+                return Fate::Detected;
+            }
+            let Some(Hit { surf, struck }) = surf else {
+                return Fate::Escaped;
+            };
+            let model = self.model(struck);
+            let at = Arrival {
+                media: &scene.media,
+                hit: &surf,
+                dir: true_ray.dir,
+                medium: p.medium,
+                est: self.estimator,
+                light: p.light,
+            };
+            let (outcome, feature) = model.interact_on(&at, rng);
+            struck.count(&mut out.ledger, feature);
+            match outcome {
+                Outcome::Absorbed => return struck.absorbed(),
+                Outcome::Scattered {
+                    dir,
+                    medium,
+                    weight,
+                } => {
+                    p.reweigh(weight, struck.sink(&mut out.ledger));
+                    p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
+                    p.medium = medium;
+                }
+            }
+            if !roulette(p, rng, &mut out.ledger) {
+                return Fate::Roulette;
+            }
+        }
+        Fate::Killed
+    }
+
+    /// The surface or lamp body `p` reaches first along `true_ray` (its path from its
+    /// true position).
+    fn nearest_surface(&self, p: &Photon, true_ray: &Ray) -> Option<Hit> {
+        let mesh = self.nearest_triangle(p, true_ray).map(|surf| Hit {
+            struck: Struck::Surface(self.facets[surf.prim as usize].tag),
+            surf,
+        });
+        let t_mesh = mesh.map_or(f64::INFINITY, |h| h.surf.t);
+        self.nearest_body(p, t_mesh).or(mesh)
+    }
+
+    /// Where `true_ray` crosses the target plane before `t_surface`, if it does. Inside a
+    /// convex solid that lies wholly on one side of the target it cannot.
+    fn target_hit(&self, p: &Photon, true_ray: &Ray, t_surface: f64) -> Option<(f64, [f64; 2])> {
+        match self.convex_solid(p) {
+            Some(solid) if solid.clear_of_target => None,
+            _ => self.scene.detector.intersect(true_ray, t_surface),
+        }
+    }
+
+    /// The convex solid `p` travels in, when the fast path is on and its medium has one.
+    fn convex_solid(&self, p: &Photon) -> Option<&ConvexSolid> {
+        convex_solid(self.scene, self.convex, p.medium)
+    }
+
+    /// The triangle `p` reaches first along `true_ray`.
+    fn nearest_triangle(&self, p: &Photon, true_ray: &Ray) -> Option<SurfaceHit> {
+        let scene = self.scene;
+        match self.convex_solid(p) {
+            // The convex path needs no nudge and no refinement: it intersects the exact
+            // f64 face planes from the true position.
+            Some(solid) => solid.exit(&scene.mesh, true_ray).map(|h| SurfaceHit {
+                t: h.t,
+                prim: h.prim,
+                point: true_ray.at(h.t),
+                normal: self.facets[h.prim as usize].normal,
+            }),
+            None => self
+                .accel
+                .intersect(&p.ray.search, f64::INFINITY)
+                .map(|h| p.ray.refine_hit(&self.facets[h.prim as usize], h.prim, h.t)),
+        }
+    }
+
+    /// The nearest lamp body in `p`'s medium that `p` meets before distance `t_max`.
+    /// Bodies are intersected exactly along the search ray (which starts a spawn offset
+    /// off the surface `p` left, so a photon leaving a body never meets it again at
+    /// distance ~0); distances are measured from the true position, as for triangles.
+    fn nearest_body(&self, p: &Photon, t_max: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        // The search ray starts one spawn offset off the true position, so a body within
+        // `t_max` of the true position lies within `t_max + eps` along the search ray.
+        let reach = t_max + 2.0 * self.scene.spawn_eps;
+        for i in self.bodies.near(p.medium, &p.ray.search, reach) {
+            let Some(h) = self.body(i).hit(&p.ray.search, reach) else {
+                continue;
+            };
+            let point = p.ray.search.at(h.t);
+            let t = (point - p.ray.from).length();
+            if t < best.map_or(t_max, |b| b.surf.t) {
+                let surf = SurfaceHit {
+                    t,
+                    prim: NO_TRIANGLE,
+                    point,
+                    normal: h.normal,
+                };
+                let struck = if h.front {
+                    Struck::Body(i)
+                } else {
+                    Struck::BodyBack(i)
+                };
+                best = Some(Hit { surf, struck });
+            }
+        }
+        best
+    }
+
+    /// The body of source `i` (one that has a body).
+    fn body(&self, i: u32) -> &LampBody {
+        let body = self.scene.sources.list[i as usize].body.as_ref();
+        body.expect("only sources with bodies are listed")
+    }
+
+    /// The surface model a photon meets.
+    fn model(&self, struck: Struck) -> &SurfaceModel {
+        match struck {
+            Struck::Surface(tag) => &self.scene.surfaces[tag as usize],
+            Struck::Body(i) => &self.body(i).model,
+            Struck::BodyBack(_) => &SurfaceModel::Absorber(Absorber),
+        }
+    }
+
+    /// The medium along `true_ray` up to the next event at `t`. Clear media: Beer-Lambert
+    /// (analog: absorbed or not; weighted: the weight attenuated and the loss booked to
+    /// the medium). Scattering media: a free flight ([`flight::fly`]) that may end in a
+    /// scattering event, after which `p` travels on from the scattering point.
+    fn cross_medium(
+        &self,
+        p: &mut Photon,
+        true_ray: &Ray,
+        t: f64,
+        rng: &mut PhotonRng,
+        ledger: &mut Ledger,
+    ) -> Flight {
+        let medium = &self.scene.media[p.medium as usize];
+        let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
+        if medium.scattering.per_mm > 0.0 {
+            let eps = self.scene.spawn_eps;
+            let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
+            let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
+            if let Flight::Scattered { t, dir } = flight {
+                // Inside the medium, clear of surfaces: the search needs no nudge.
+                p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
+            }
+            return flight;
+        }
+        if absorb_clear(p, medium.absorption(p.light), t, self.estimator, rng, sink) {
+            Flight::Absorbed
+        } else {
+            Flight::Reached
+        }
+    }
+
+    /// Trace chunk `index` (photons `index*CHUNK .. min(+CHUNK, end)`) of the run seeded
+    /// `seed`: the same tally whichever thread traces it, and whenever.
+    pub fn trace_chunk(&self, seed: u64, index: u64, end: u64) -> ChunkTally {
+        let lo = index * CHUNK;
+        let hi = (lo + CHUNK).min(end);
+        let mut out = ChunkTally {
+            index,
+            detections: Vec::new(),
+            ledger: Ledger::new(
+                self.scene.tags.len(),
+                self.scene.media.len(),
+                self.scene.sources.list.len(),
+            ),
+        };
+        for i in lo..hi {
+            self.trace_photon(seed, i, &mut out);
+        }
+        out
+    }
+}
+
+/// The `prim` of a hit on a lamp body, which is no triangle of the mesh.
+const NO_TRIANGLE: u32 = u32::MAX;
+
+/// What a photon's segment ends on.
+#[derive(Clone, Copy, Debug)]
+enum Struck {
+    /// A triangle with this tag.
+    Surface(u32),
+    /// The body of the source with this index.
+    Body(u32),
+    /// The absorbing back of an LED's one-sided body.
+    BodyBack(u32),
+}
+
+impl Struck {
+    /// The fate of a photon absorbed there.
+    fn absorbed(self) -> Fate {
+        match self {
+            Struck::Surface(tag) => Fate::AbsorbedBySurface(tag),
+            Struck::Body(i) | Struck::BodyBack(i) => Fate::AbsorbedBySource(i),
+        }
+    }
+
+    /// Count the interaction: per tag (and whether it met the tag's pattern) on a surface,
+    /// only in the total on a lamp body.
+    fn count(self, ledger: &mut Ledger, feature: Feature) {
+        match self {
+            Struck::Surface(tag) => ledger.hit(tag, feature != Feature::Plain),
+            Struck::Body(_) | Struck::BodyBack(_) => ledger.interactions += 1,
+        }
+    }
+
+    /// The ledger entry that books what is absorbed there.
+    fn sink(self, ledger: &mut Ledger) -> &mut ExactSum {
+        match self {
+            Struck::Surface(tag) => &mut ledger.absorbed_by_surface[tag as usize],
+            Struck::Body(i) | Struck::BodyBack(i) => &mut ledger.absorbed_by_source[i as usize],
+        }
+    }
+}
+
+/// A hit and what was struck.
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    surf: SurfaceHit,
+    struck: Struck,
+}
+
+/// Beer-Lambert along `t` through a clear medium absorbing `a` per mm (analog: true when
+/// the photon is absorbed; weighted: its weight attenuated and the loss booked to `sink`).
+/// A photon leaving the scene inside an absorbing medium (t infinite: the black surround
+/// the physics and stability tests use to catch leaks) is absorbed there, under both
+/// estimators.
+fn absorb_clear(
+    p: &mut Photon,
+    a: f64,
+    t: f64,
+    estimator: Estimator,
+    rng: &mut PhotonRng,
+    sink: &mut ExactSum,
+) -> bool {
+    if a == 0.0 {
+        return false;
+    }
+    match estimator {
+        Estimator::Analog => {
+            // Absorption is memoryless: one exponential depth per photon, spent
+            // segment by segment (a t each), has the law of a fresh free path per
+            // segment, without a logarithm and a random draw on every segment.
+            if p.absorption_depth < 0.0 {
+                p.absorption_depth = -(1.0 - rng.uniform()).ln();
+            }
+            let spent = a * t;
+            if spent > p.absorption_depth {
+                return true;
+            }
+            p.absorption_depth -= spent;
+            false
+        }
+        Estimator::Weighted => {
+            // exp(-a t) at any length, to infinity included.
+            let w = if t.is_finite() {
+                p.weight * (-a * t).exp()
+            } else {
+                0.0
+            };
+            Ledger::lose(sink, p.weight, w);
+            p.weight = w;
+            false
+        }
+    }
+}
+
+/// Russian roulette on low weights (weighted estimator only): false when the photon dies.
+fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
+    if p.weight >= ROULETTE_BELOW {
+        return true;
+    }
+    if rng.uniform() * ROULETTE_SURVIVOR < p.weight {
+        Ledger::lose(&mut ledger.roulette, p.weight, ROULETTE_SURVIVOR);
+        p.weight = ROULETTE_SURVIVOR;
+        true
+    } else {
+        false
+    }
+}
+
+fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Detection {
+    let d = &scene.detector;
+    Detection {
+        flux_bin: d.flux_index(ab) as u32,
+        angular_bin: d.angular_index(dir) as u32,
+        weight,
+    }
+}
+
+/// For the tracer's tests: chunks 0 and 7 (seed 5) of the bundled scene `name`, traced
+/// by a tracer as built (BVH backend, convex path on) and by one changed by `alter`, are
+/// the same bits (ledgers and detections); returns the first tracer's chunks.
+#[cfg(test)]
+fn assert_same_chunks(
+    name: &str,
+    estimator: Estimator,
+    alter: impl FnOnce(&mut Tracer),
+) -> Vec<ChunkTally> {
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
+    let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
+    let accel = crate::accel::build(crate::accel::BackendChoice::Bvh, scene.mesh.clone()).unwrap();
+    let facets = scene.mesh.facets();
+    let built = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    let mut altered = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    alter(&mut altered);
+    [0, 7]
+        .map(|chunk| {
+            let (a, b) = (
+                built.trace_chunk(5, chunk, u64::MAX),
+                altered.trace_chunk(5, chunk, u64::MAX),
+            );
+            assert_eq!(a.ledger, b.ledger, "{name} {estimator:?} chunk {chunk}");
+            assert_eq!(
+                a.detections, b.detections,
+                "{name} {estimator:?} chunk {chunk}"
+            );
+            a
+        })
+        .into()
+}

@@ -43,6 +43,17 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<optimization::Optimization>()?;
     m.add_function(wrap_pyfunction!(run::merge, m)?)?;
     m.add_function(wrap_pyfunction!(run::read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_on_worker, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
+}
+
+/// Panic on a worker thread, as a bug in the library would: the test suite checks that it
+/// raises `BlutraceError` and leaves the interpreter running.
+#[pyfunction]
+fn _panic_on_worker(py: Python<'_>) -> PyResult<()> {
+    detached::detached(py, || -> anyhow::Result<()> {
+        panic!("a deliberate panic")
+    })?
+    .map_err(convert::run_error)
 }

@@ -149,7 +149,7 @@ pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64) -> PyResult<u64> {
     }
     let n: u64 = if v.is_instance_of::<PyFloat>() {
         let x: f64 = v.extract()?;
-        if !(x.is_finite() && x.fract() == 0.0 && x >= 0.0 && x < 1.8e19) {
+        if !(x.fract() == 0.0 && (0.0..1.8e19).contains(&x)) {
             return Err(bad());
         }
         x as u64

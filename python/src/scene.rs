@@ -248,8 +248,11 @@ impl Scene {
             },
             |py| progress::update(py, &reporter, done.load(Ordering::Relaxed)),
         );
-        progress::close(py, &reporter, done.load(Ordering::Relaxed))?;
-        Ok(Run::new(traced?.map_err(run_error)?))
+        // An interrupt or error of the trace outranks one of the progress display.
+        let closed = progress::close(py, &reporter, done.load(Ordering::Relaxed));
+        let run = Run::new(traced?.map_err(run_error)?);
+        closed?;
+        Ok(run)
     }
 
     /// ``optimize(method=None, vary=None, **options) -> Optimization`` optimizes the dot
@@ -273,10 +276,14 @@ impl Scene {
         optimization::optimize_scene(py, &self.inner, method, vary, options)
     }
 
+    /// A scene pickles as its scene file's text and path (`from_toml` restores it).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let cls = py.get_type::<Scene>();
         let from_toml = cls.getattr("from_toml")?;
-        let args = (self.to_toml()?, self.path());
+        // Absolute, so a worker started in another folder finds the geometry files.
+        let path =
+            std::path::absolute(&self.inner.path).unwrap_or_else(|_| self.inner.path.clone());
+        let args = (self.to_toml()?, path);
         PyTuple::new(py, [from_toml, args.into_pyobject(py)?.into_any()])
     }
 

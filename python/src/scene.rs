@@ -183,9 +183,9 @@ impl Scene {
         convert::json_to_py(py, &report)
     }
 
-    /// ``trace(photons=None, seed=None, threads=None, estimator="analog", target_error=None,
-    /// target_metric="mean", max_time=None, progress=None, shard=None, backend="auto") -> Run``
-    /// traces it. ``photons`` defaults to the scene's ``[trace] photons`` (1e9 as a cap when
+    /// Trace the scene and return the `Run`.
+    ///
+    /// ``photons`` defaults to the scene's ``[trace] photons`` (1e9 as a cap when
     /// ``target_error`` or ``max_time`` is given) and ``seed`` to its ``[trace] seed``;
     /// ``threads`` defaults to all cores (results do not depend on it); ``estimator`` is
     /// "analog" or "weighted"; ``target_error`` stops once the relative standard error of
@@ -255,10 +255,9 @@ impl Scene {
         Ok(run)
     }
 
-    /// ``optimize(method=None, vary=None, **options) -> Optimization`` optimizes the dot
-    /// density ("nelder-mead", the default, or "feedback"), or with ``vary={"key": (lo, hi)}``
-    /// the numbers those key paths name ("nelder-mead" or "grid"). The options are those of
-    /// ``blutrace optimize`` with underscores: ``photons`` (1e6 per design), ``seed``,
+    /// Optimize the dot density ("nelder-mead", the default, or "feedback"), or with
+    /// ``vary={"key": (lo, hi)}`` the numbers those key paths name ("nelder-mead" or
+    /// "grid"). The options are those of ``blutrace optimize`` with underscores: ``photons`` (1e6 per design), ``seed``,
     /// ``max_iter``, ``target_cv``, ``objective`` ("cv", "thirteen-point", "efficiency" or a mix
     /// "cv=1,efficiency=0.5"), ``grid_points``, ``degree``, ``min_density``, ``max_density``,
     /// ``tag``, ``initial_step``, ``simplex_tol``, ``alpha``, ``smoothing``, ``dims``, ``cells``,

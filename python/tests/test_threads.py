@@ -35,22 +35,47 @@ def test_other_python_threads_run_during_a_trace(box):
     assert during > 10_000, f"the counting thread counted {during} in {elapsed:.2f} s"
 
 
-@pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="no SIGINT")
-def test_sigint_stops_a_trace_within_a_second_and_raises(box, tmp_path):
+def interrupted_after(seconds: float, call) -> float:
+    """Send this process a real SIGINT after `seconds` while `call()` runs; assert that it
+    raises KeyboardInterrupt and return how long after the signal it stopped."""
     assert threading.current_thread() is threading.main_thread()
     # Python's own Ctrl-C handler, even where the test runner was started with SIGINT
     # ignored (a background job of a shell).
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
     try:
         start = time.monotonic()
         timer.start()
         with pytest.raises(KeyboardInterrupt):
-            # Far more photons than 0.5 s can trace; max_time bounds a failing test.
-            box.trace(photons=1e9, max_time=60, seed=1)
-        stopped = time.monotonic() - start
+            call()
+        return time.monotonic() - start - seconds
     finally:
         timer.join()
         signal.signal(signal.SIGINT, previous)
-    assert stopped < 0.5 + 1.5, f"took {stopped:.2f} s to stop"
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="no SIGINT")
+def test_sigint_stops_a_trace_within_a_second_and_raises(box, tmp_path):
+    # Far more photons than 0.5 s can trace; max_time bounds a failing test.
+    late = interrupted_after(0.5, lambda: box.trace(photons=1e9, max_time=60, seed=1))
+    assert late < 1.5, f"took {late:.2f} s to stop"
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="no SIGINT")
+def test_sigint_stops_an_optimization_and_raises(phone):
+    late = interrupted_after(
+        0.5, lambda: phone.optimize(method="feedback", photons=2e7, max_iter=3, verify_photons=0)
+    )
+    assert late < 1.5, f"took {late:.2f} s to stop"
+
+
+def test_an_exception_of_the_progress_callable_stops_the_trace(box):
+    def fail(done, total):
+        if done:
+            raise RuntimeError("stop here")
+
+    start = time.monotonic()
+    with pytest.raises(RuntimeError, match="stop here"):
+        box.trace(photons=1e9, max_time=60, seed=1, progress=fail)
+    assert time.monotonic() - start < 5

@@ -26,13 +26,15 @@ def test_feedback_tunes_the_density_and_writes_the_command_lines_files(phone, tm
     assert again.content_hash == opt.scene.content_hash
 
 
-def test_a_grid_over_a_key_path_traces_each_value(phone):
+def test_a_grid_over_a_key_path_traces_each_value(phone, capsys):
     key = "sources.*.center.2"
     opt = phone.optimize(
         method="grid", vary={key: (0.2, 0.35)}, grid_points=3, photons=20_000,
-        verify_photons=0, objective="efficiency",
+        verify_photons=0, objective="efficiency", progress=True,
     )
     assert len(opt.history) == 3
+    lines = [l for l in capsys.readouterr().err.splitlines() if l.startswith("eval")]
+    assert len(lines) == 3 and key in lines[0]
     assert sorted(round(h["values"][0], 6) for h in opt.history) == [0.2, 0.275, 0.35]
     assert opt.scene.get(key) in (0.2, 0.275, 0.35)
     assert opt.summary["variables"][0]["name"] == key

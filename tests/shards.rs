@@ -196,3 +196,48 @@ fn merge_keeps_its_inputs_and_checks_their_tallies() {
         "{err}"
     );
 }
+
+/// Shards kept in memory (`ShardFile::of`, no file written) check and merge into the
+/// single run's tallies bit for bit, as the Python package's `merge` uses them.
+#[test]
+fn shards_held_in_memory_merge_to_the_single_run() {
+    use blutrace::run::{RunOptions, Shard};
+    use blutrace::shard::{self, ShardFile};
+    let scene = support::load(&Path::new(SCENE).join("scene.toml"));
+    let options = RunOptions {
+        photons: 100_000,
+        seed: 5,
+        threads: Some(2),
+        ..RunOptions::default()
+    };
+    let single = support::trace_opts(&scene, &options);
+    let shards: Vec<_> = (0..3)
+        .map(|index| {
+            let run = support::trace_opts(
+                &scene,
+                &RunOptions {
+                    shard: Some(Shard { index, count: 3 }),
+                    ..options.clone()
+                },
+            );
+            let file = ShardFile::of(&run).unwrap();
+            assert_eq!(
+                file.range,
+                [run.options.photon_range().0, run.options.photon_range().1]
+            );
+            (format!("shard {index}/3").into(), file)
+        })
+        .collect();
+    assert!(shard::check(&shards, &scene).unwrap().is_empty());
+    let merged = shard::merge(&shards, &scene).unwrap();
+    assert_eq!(merged.tally.ledger.photons, 100_000);
+    let (a, b) = (single.flux_map(), merged.flux_map());
+    assert_eq!(a.value, b.value);
+    assert_eq!(a.stderr, b.stderr);
+    assert_eq!(a.hits, b.hits);
+    assert_eq!(single.angular_map().value, merged.angular_map().value);
+    assert!(
+        ShardFile::of(&single).is_err(),
+        "a run of all photons is no shard"
+    );
+}

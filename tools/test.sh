@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite, exactly as CI runs it (.ci/run calls this script).
 # Fetches the Embree 4 library first, so every backend is tested; on a machine without
-# network, set BLUTRACE_SKIP_EMBREE=1 to test the pure-Rust backends only.
+# network, set BLUTRACE_SKIP_EMBREE=1 to test the pure-Rust backends only. After the Rust
+# tests, tools/test-python.sh builds the Python package and runs its pytest suite (a venv
+# under target/, packages from PyPI); BLUTRACE_SKIP_PYTHON=1 skips it.
 #
 # The tests run with TMPDIR set to a new empty folder, so nothing an earlier run left in
 # the machine's temporary folder can make a test pass; afterwards that folder must be
@@ -24,6 +26,9 @@ checkout_files() {
 before=$(checkout_files)
 
 TMPDIR="$scratch" cargo test --workspace --release "$@"
+if [ "${BLUTRACE_SKIP_PYTHON:-0}" != "1" ]; then
+  TMPDIR="$scratch" bash tools/test-python.sh
+fi
 
 status=0
 left=$(cd "$scratch" && find . -mindepth 1 -maxdepth 2 | head -20)

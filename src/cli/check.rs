@@ -59,40 +59,14 @@ fn scattering(m: &Medium) -> String {
     )
 }
 
-/// One medium for `check --json`.
-fn medium_json(m: &Medium) -> serde_json::Value {
-    serde_json::json!({
-        "name": m.name,
-        "n": m.n,
-        "absorption_per_mm": m.absorption_per_mm,
-        "scattering_per_mm": m.scattering.per_mm,
-        "anisotropy": m.scattering.anisotropy,
-        "phase_table": m.scattering.table.is_some(),
-        "particles": m.particles,
-    })
-}
-
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {
     let scene = Scene::load(path)?;
-    let tally_bytes = blutrace::run::check_tally_budget(&scene)?;
     if json {
-        let report = serde_json::json!({
-            "scene": scene.name,
-            "scene_file": path.display().to_string(),
-            "geometry": scene.geometry,
-            "tally_bytes": tally_bytes,
-            "sources": scene.sources.list.iter().map(|s| serde_json::json!({
-                "name": s.name,
-                "power_w": s.power_w,
-                "medium": scene.media[s.medium as usize].name,
-                "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
-            })).collect::<Vec<_>>(),
-            "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),
-            "warnings": scene.warnings,
-        });
+        let report = blutrace::scene::check_report::check_json(&scene, path)?;
         say!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
+    let tally_bytes = blutrace::run::check_tally_budget(&scene)?;
     say!("scene      {} ({})", scene.name, path.display());
     say!(
         "geometry   {} triangles, {} tags",

@@ -63,29 +63,38 @@ pub struct ShardFile {
     pub groups: Vec<Tally>,
 }
 
+impl ShardFile {
+    /// The shard file of `result`, a shard run (`RunOptions::shard` set), held in memory:
+    /// what [`write_shard`] writes, and what a caller that keeps shards as values (the
+    /// Python package) hands to [`check`] and [`merge`].
+    pub fn of(result: &RunResult) -> Result<ShardFile> {
+        let o = &result.options;
+        let shard = o.shard.context("not a shard run")?;
+        let (first, last) = o.photon_range();
+        Ok(ShardFile {
+            format: FORMAT.into(),
+            version: FORMAT_VERSION,
+            scene: result.scene.name.clone(),
+            // Absolute, so `merge` finds it from any folder.
+            scene_file: std::path::absolute(&result.scene.path)
+                .unwrap_or_else(|_| result.scene.path.clone()),
+            scene_hash: format!("{:016x}", result.scene.content_hash()),
+            seed: o.seed,
+            photons: o.photons,
+            shard,
+            range: [first, last],
+            estimator: o.estimator,
+            backend: result.backend.to_string(),
+            runtime_s: result.runtime_s,
+            threads: result.threads,
+            groups: result.groups.clone(),
+        })
+    }
+}
+
 /// Write `result` (a shard run) as `dir/shard.json`, atomically.
 pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
-    let o = &result.options;
-    let shard = o.shard.context("not a shard run")?;
-    let (first, last) = o.photon_range();
-    let file = ShardFile {
-        format: FORMAT.into(),
-        version: FORMAT_VERSION,
-        scene: result.scene.name.clone(),
-        // Absolute, so `merge` finds it from any folder.
-        scene_file: std::path::absolute(&result.scene.path)
-            .unwrap_or_else(|_| result.scene.path.clone()),
-        scene_hash: format!("{:016x}", result.scene.content_hash()),
-        seed: o.seed,
-        photons: o.photons,
-        shard,
-        range: [first, last],
-        estimator: o.estimator,
-        backend: result.backend.to_string(),
-        runtime_s: result.runtime_s,
-        threads: result.threads,
-        groups: result.groups.clone(),
-    };
+    let file = ShardFile::of(result)?;
     let staged = OutputSet::new(dir, &[SHARD_FILE])?;
     let path = staged.write_bytes(SHARD_FILE, &serde_json::to_vec(&file)?)?;
     staged.commit()?;

@@ -8,6 +8,7 @@
 //! - moves the scene's centre to the origin, so f32 backends keep their precision far
 //!   from the file's origin (outputs are in detector coordinates, so nothing changes).
 
+pub mod check_report;
 pub mod config;
 pub mod geometry_file;
 pub mod geometry_report;

@@ -1,0 +1,44 @@
+"""blutrace: Monte Carlo photon tracing and optimization of LCD backlight units.
+
+>>> import blutrace as bt
+>>> scene = bt.Scene.load("scenes/notebook14")      # a folder or a scene.toml
+>>> scene.set("surfaces.lgp_back.ink_albedo", 0.8)  # key paths as `optimize --vary`
+>>> run = scene.trace(photons=1_000_000, seed=1)
+>>> run.flux.shape, run.efficiency                   # numpy (ny, nx) W/mm^2; (value, stderr)
+
+Array conventions: ``Run.flux``, ``flux_stderr`` and ``hits`` have shape ``(ny, nx)``:
+row ``iy`` is the ``iy``-th bin along the detector's ``v`` from its origin, column ``ix``
+along ``u``; ``flux`` is irradiance in W/mm^2 per bin. ``Run.angular`` and
+``angular_stderr`` have shape ``(n_theta, n_phi)``, radiant intensity in W/sr per bin.
+The same seed and photons give the same arrays bit for bit on any thread count, and the
+same as the command line's ``flux.exr`` (stored there as float32).
+
+Tracing releases the GIL; Ctrl-C (``KeyboardInterrupt``) stops a trace within a second
+and raises, writing nothing. Errors are exceptions: ``SceneError`` for a scene file (the
+message names the file and the field), ``ValueError`` for a bad argument, and
+``BlutraceError`` for anything else (an internal error included).
+"""
+
+from __future__ import annotations
+
+from ._native import (
+    BlutraceError,
+    Optimization,
+    Run,
+    Scene,
+    SceneError,
+    __version__,
+    merge,
+    read_exr,
+)
+
+__all__ = [
+    "BlutraceError",
+    "Optimization",
+    "Run",
+    "Scene",
+    "SceneError",
+    "__version__",
+    "merge",
+    "read_exr",
+]

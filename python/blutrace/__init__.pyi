@@ -1,0 +1,163 @@
+"""Type stubs of blutrace (the classes and functions of its Rust extension module)."""
+
+from os import PathLike
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = Union[str, "PathLike[str]"]
+_Count = Union[int, float]
+_TraceProgress = Union[bool, None, Callable[[int, int], Any]]
+_SearchProgress = Union[bool, None, Callable[[Dict[str, Any]], Any]]
+
+class BlutraceError(Exception):
+    """Base class of blutrace's errors (a run or a write that failed, an internal error)."""
+
+class SceneError(BlutraceError):
+    """A scene file, or a file it names, is wrong: the message names the file and field."""
+
+class Scene:
+    """A validated, traceable scene: a value (``copy()`` gives an independent one)."""
+
+    @staticmethod
+    def load(path: _Path) -> Scene:
+        """Load and validate a scene file, or ``scene.toml`` in a folder."""
+    @staticmethod
+    def from_toml(text: str, path: _Path) -> Scene:
+        """A scene from the text of a scene file; geometry relative to ``path``'s folder."""
+    def to_toml(self) -> str:
+        """The scene file as TOML text (with any ``set`` applied)."""
+    @property
+    def name(self) -> str: ...
+    @property
+    def path(self) -> str: ...
+    @property
+    def warnings(self) -> List[str]: ...
+    @property
+    def default_photons(self) -> int: ...
+    @property
+    def default_seed(self) -> int: ...
+    @property
+    def content_hash(self) -> str: ...
+    @property
+    def source(self) -> Dict[str, Any]:
+        """The scene file as a dict (with any ``set`` applied)."""
+    def get(self, key: str) -> Any:
+        """The value at a key path such as ``sources.0.center.2`` (``*``: every element)."""
+    def set(self, key: str, value: Any) -> None:
+        """Set the value at a key path; the scene is loaded again (``SceneError`` if bad)."""
+    def copy(self) -> Scene:
+        """An independent copy."""
+    def __copy__(self) -> Scene: ...
+    def __deepcopy__(self, memo: Any) -> Scene: ...
+    def check(self) -> Dict[str, Any]:
+        """What ``blutrace check --json`` prints."""
+    def trace(
+        self,
+        photons: Optional[_Count] = None,
+        seed: Optional[int] = None,
+        threads: Optional[int] = None,
+        estimator: str = "analog",
+        target_error: Optional[float] = None,
+        target_metric: str = "mean",
+        max_time: Optional[float] = None,
+        progress: _TraceProgress = None,
+        shard: Optional[Tuple[int, int]] = None,
+        backend: str = "auto",
+    ) -> Run:
+        """Trace the scene (the GIL is released; Ctrl-C raises KeyboardInterrupt)."""
+    def optimize(
+        self,
+        method: Optional[str] = None,
+        vary: Optional[Mapping[str, Tuple[float, float]]] = None,
+        *,
+        objective: str = ...,
+        grid_points: int = ...,
+        photons: _Count = ...,
+        seed: int = ...,
+        max_iter: int = ...,
+        target_cv: Optional[float] = ...,
+        degree: Optional[int] = ...,
+        min_density: float = ...,
+        max_density: Optional[float] = ...,
+        tag: Optional[str] = ...,
+        initial_step: float = ...,
+        simplex_tol: float = ...,
+        alpha: float = ...,
+        smoothing: float = ...,
+        dims: int = ...,
+        cells: Optional[Tuple[int, int]] = ...,
+        strips: Optional[int] = ...,
+        edge_margin_mm: float = ...,
+        verify_photons: _Count = ...,
+        verify_seed: Optional[int] = ...,
+        threads: Optional[int] = ...,
+        estimator: str = ...,
+        backend: str = ...,
+        export_placement: Optional[str] = ...,
+        progress: _SearchProgress = ...,
+    ) -> Optimization:
+        """Optimize the dot density, or with ``vary`` the numbers its key paths name."""
+
+class Run:
+    """A finished trace, or the merge of shard runs."""
+
+    @property
+    def flux(self) -> npt.NDArray[np.float64]:
+        """Irradiance (W/mm^2 per bin), shape (ny, nx), row iy along v from the origin."""
+    @property
+    def flux_stderr(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def hits(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def angular(self) -> npt.NDArray[np.float64]:
+        """Radiant intensity (W/sr per bin), shape (n_theta, n_phi)."""
+    @property
+    def angular_stderr(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def angular_hits(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def summary(self) -> Dict[str, Any]:
+        """The content of summary.json."""
+    @property
+    def efficiency(self) -> Tuple[float, float]:
+        """Extraction efficiency and its standard error."""
+    @property
+    def history(self) -> List[Dict[str, Any]]: ...
+    @property
+    def photons(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def shard(self) -> Optional[Tuple[int, int]]: ...
+    @property
+    def stopped_by(self) -> str: ...
+    @property
+    def runtime_s(self) -> float: ...
+    @property
+    def scene(self) -> Scene: ...
+    def write(self, dir: _Path) -> List[str]:
+        """Write the command line's output set into ``dir``, all or nothing."""
+
+class Optimization:
+    """The outcome of ``Scene.optimize``."""
+
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def history(self) -> List[Dict[str, Any]]: ...
+    @property
+    def summary(self) -> Dict[str, Any]: ...
+    @property
+    def interrupted(self) -> bool: ...
+    def write(self, dir: _Path) -> List[str]:
+        """Write what ``blutrace optimize`` writes into ``dir``, all or nothing."""
+
+def merge(runs: Sequence[Run], partial: bool = False) -> Run:
+    """Merge shard runs into the run of all their photons, bit for bit."""
+
+def read_exr(path: _Path) -> Dict[str, npt.NDArray[np.float32]]:
+    """The channels of an EXR image blutrace wrote, as (ny, nx) float32 arrays."""

@@ -1,0 +1,59 @@
+//! `blutrace._native`: the blutrace library as a Python extension module (pyo3). The
+//! Python package `blutrace` (`python/blutrace/`) re-exports everything here; its
+//! docstrings and type stubs (`__init__.pyi`) are the user's reference.
+//!
+//! - [`scene`]: `Scene` (load, key paths, check, trace, optimize);
+//! - [`run`]: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
+//! - [`optimization`]: `Optimization`, the outcome of `Scene.optimize`;
+//! - [`detached`]: long work on a thread of its own, with the GIL released, Ctrl-C
+//!   honoured and panics turned into exceptions;
+//! - [`convert`]: TOML and JSON values to and from Python objects, and argument checks.
+
+mod convert;
+mod detached;
+mod optimization;
+mod progress;
+mod run;
+mod scene;
+
+use pyo3::create_exception;
+use pyo3::prelude::*;
+
+create_exception!(
+    _native,
+    BlutraceError,
+    pyo3::exceptions::PyException,
+    "Base class of blutrace's errors (a run or a write that failed, an internal error)."
+);
+create_exception!(
+    _native,
+    SceneError,
+    BlutraceError,
+    "A scene file, or a file it names, is wrong: the message names the file and the field."
+);
+
+/// The extension module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("BlutraceError", py.get_type::<BlutraceError>())?;
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<run::Run>()?;
+    m.add_class::<optimization::Optimization>()?;
+    m.add_function(wrap_pyfunction!(run::merge, m)?)?;
+    m.add_function(wrap_pyfunction!(run::read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_on_worker, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
+
+/// Panic on a worker thread, as a bug in the library would: the test suite checks that it
+/// raises `BlutraceError` and leaves the interpreter running.
+#[pyfunction]
+fn _panic_on_worker(py: Python<'_>) -> PyResult<()> {
+    detached::detached(py, || -> anyhow::Result<()> {
+        panic!("a deliberate panic")
+    })?
+    .map_err(convert::run_error)
+}

@@ -1,0 +1,260 @@
+//! `Scene.optimize` and its outcome, `blutrace.Optimization`: the dot-density searches
+//! (Nelder-Mead, feedback) and, with `vary`, the search over numbers of the scene file,
+//! with the command line's options as keywords.
+
+use crate::BlutraceError;
+use crate::convert::{choice, count, run_error, serialized};
+use crate::detached::{detached, run_detached};
+use crate::scene::{BACKENDS, ESTIMATORS, Scene, threads_arg};
+use blutrace::optics::dots::Placement;
+use blutrace::optimize::layout::{ObjectiveSpec, VarySpec};
+use blutrace::optimize::{
+    LayoutResult, Method, OptimizeOptions, OptimizeResult, optimize, optimize_layout,
+};
+use blutrace::scene::Scene as RustScene;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc;
+
+/// Spellings of the methods.
+const METHODS: &[(&str, Method)] = &[
+    ("nelder-mead", Method::NelderMead),
+    ("feedback", Method::Feedback),
+    ("grid", Method::Grid),
+];
+
+/// What a search found.
+enum Outcome {
+    Density(Box<OptimizeResult>),
+    Layout(Box<LayoutResult>),
+}
+
+/// The outcome of ``Scene.optimize``.
+///
+/// ``scene`` is the optimized scene (``optimized.toml``), ``history`` one dict per iteration
+/// or evaluated design, ``summary`` the content of ``optimize.json``, ``interrupted`` whether
+/// Ctrl-C ended the search early; ``write(dir)`` writes what ``blutrace optimize`` writes.
+#[pyclass(module = "blutrace", name = "Optimization", frozen)]
+pub struct Optimization {
+    outcome: Arc<Outcome>,
+    scene: Scene,
+}
+
+#[pymethods]
+impl Optimization {
+    /// The optimized scene (the file `optimized.toml` holds; file paths absolute).
+    #[getter]
+    fn scene(&self) -> Scene {
+        self.scene.clone()
+    }
+
+    /// One dict per iteration (density searches) or evaluated design (`vary`), as
+    /// `history.csv` lists them.
+    #[getter]
+    fn history<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &*self.outcome {
+            Outcome::Density(r) => serialized(py, &r.history),
+            Outcome::Layout(r) => serialized(py, &r.history),
+        }
+    }
+
+    /// Everything the search reports: the content of `optimize.json`.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &*self.outcome {
+            Outcome::Density(r) => serialized(py, &**r),
+            Outcome::Layout(r) => serialized(py, &**r),
+        }
+    }
+
+    /// Whether Ctrl-C stopped the search early (its outcome is the best design so far).
+    #[getter]
+    fn interrupted(&self) -> bool {
+        match &*self.outcome {
+            Outcome::Density(r) => r.interrupted,
+            Outcome::Layout(r) => r.interrupted,
+        }
+    }
+
+    /// Write what `blutrace optimize` writes into `dir`, all or nothing; returns the files
+    /// and folders written.
+    fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<String>> {
+        let outcome = self.outcome.clone();
+        let files = detached(py, || match &*outcome {
+            Outcome::Density(r) => r.write(&dir),
+            Outcome::Layout(r) => r.write(&dir),
+        })?
+        .map_err(run_error)?;
+        Ok(files.iter().map(|f| f.display().to_string()).collect())
+    }
+
+    fn __repr__(&self) -> String {
+        let (method, n) = match &*self.outcome {
+            Outcome::Density(r) => (r.method, r.history.len()),
+            Outcome::Layout(r) => (r.method, r.history.len()),
+        };
+        format!(
+            "Optimization(method='{method}', steps={n}, scene={:?})",
+            self.scene.inner.name
+        )
+    }
+}
+
+/// `scene.optimize(method, vary, **options)`.
+pub fn optimize_scene(
+    py: Python<'_>,
+    scene: &Arc<RustScene>,
+    method: Option<&str>,
+    vary: Option<&Bound<'_, PyDict>>,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Optimization> {
+    let method = choice("method", method.unwrap_or("nelder-mead"), METHODS)?;
+    let mut o = OptimizeOptions::for_method(method);
+    o.seed = scene.default_seed;
+    if let Some(vary) = vary {
+        for (key, range) in vary.iter() {
+            let key: String = key.extract()?;
+            let (lo, hi): (f64, f64) = range.extract().map_err(|_| {
+                PyValueError::new_err(format!("vary[{key:?}] must be a (min, max) pair"))
+            })?;
+            let spec: VarySpec = format!("{key}={lo:?}..{hi:?}")
+                .parse()
+                .map_err(PyValueError::new_err)?;
+            o.vary.push(spec);
+        }
+    }
+    let mut progress = None;
+    if let Some(kwargs) = kwargs {
+        for (k, v) in kwargs.iter() {
+            let k: String = k.extract()?;
+            set_option(&mut o, &k, &v, &mut progress)?;
+        }
+    }
+    let reporter = crate::progress::reporter(py, progress.as_ref(), 0)?;
+    let (tx, rx) = mpsc::channel::<(String, serde_json::Value)>();
+    let shared = scene.clone();
+    let options = o.clone();
+    let work = move || -> anyhow::Result<Outcome> {
+        if options.vary.is_empty() {
+            let r = optimize(&shared, &options, &mut |r| {
+                let _ = tx.send((r.to_string(), serde_json::to_value(r).unwrap_or_default()));
+            })?;
+            Ok(Outcome::Density(Box::new(r)))
+        } else {
+            let r = optimize_layout(&shared, &options, &mut |r, names| {
+                let result = match (&r.result, &r.rejected) {
+                    (Some(e), _) => e.to_string(),
+                    (None, Some(why)) => format!("not traced: {why}"),
+                    (None, None) => String::new(),
+                };
+                let line = format!(
+                    "eval {:>4}  {}  {result}",
+                    r.evaluation,
+                    r.assignment(names)
+                );
+                let _ = tx.send((line, serde_json::to_value(r).unwrap_or_default()));
+            })?;
+            Ok(Outcome::Layout(Box::new(r)))
+        }
+    };
+    let drain = |py: Python<'_>| -> PyResult<()> {
+        while let Ok((line, record)) = rx.try_recv() {
+            crate::progress::event(py, &reporter, &line, &record)?;
+        }
+        Ok(())
+    };
+    let searched = run_detached(py, &o.interrupt, work, drain);
+    drain(py)?;
+    let outcome = searched?.map_err(|e| {
+        if blutrace::run::is_interrupted(&e) {
+            BlutraceError::new_err("interrupted before the first design was traced")
+        } else {
+            run_error(e)
+        }
+    })?;
+    let toml_text = match &outcome {
+        Outcome::Density(r) => r.optimized_toml(),
+        Outcome::Layout(r) => r.optimized_toml(),
+    }
+    .map_err(run_error)?;
+    let optimized = Scene::from_toml(py, &toml_text, scene.path.clone())?;
+    Ok(Optimization {
+        outcome: Arc::new(outcome),
+        scene: optimized,
+    })
+}
+
+/// Set option `key` of `o` from a keyword argument (`progress` is kept aside).
+fn set_option<'py>(
+    o: &mut OptimizeOptions,
+    key: &str,
+    v: &Bound<'py, PyAny>,
+    progress: &mut Option<Bound<'py, PyAny>>,
+) -> PyResult<()> {
+    let f = |name: &str| -> PyResult<f64> {
+        v.extract::<f64>()
+            .map_err(|_| PyValueError::new_err(format!("{name} must be a number")))
+    };
+    let opt = |v: &Bound<'py, PyAny>| !v.is_none();
+    match key {
+        "progress" => *progress = opt(v).then(|| v.clone()),
+        "objective" => {
+            let s: String = v.extract()?;
+            o.objective = s.parse::<ObjectiveSpec>().map_err(PyValueError::new_err)?;
+        }
+        "grid_points" => o.grid_points = count(v, key, 2)? as usize,
+        "photons" => o.photons = count(v, key, 1)?,
+        "seed" => o.seed = count(v, key, 0)?,
+        "max_iter" => o.max_iter = count(v, key, 0)? as usize,
+        "target_cv" => o.target_cv = opt(v).then(|| f(key)).transpose()?,
+        "degree" => {
+            o.degree = opt(v)
+                .then(|| count(v, key, 0))
+                .transpose()?
+                .map(|d| d as usize)
+        }
+        "min_density" => o.min_density = f(key)?,
+        "max_density" => o.max_density = opt(v).then(|| f(key)).transpose()?,
+        "tag" => o.tag = opt(v).then(|| v.extract()).transpose()?,
+        "initial_step" => o.initial_step = f(key)?,
+        "simplex_tol" => o.simplex_tol = f(key)?,
+        "alpha" => o.alpha = f(key)?,
+        "smoothing" => o.smoothing = f(key)?,
+        "dims" => o.dims = count(v, key, 1)? as usize,
+        "cells" => o.cells = opt(v).then(|| v.extract::<(usize, usize)>()).transpose()?,
+        "strips" => {
+            o.strips = opt(v)
+                .then(|| count(v, key, 1))
+                .transpose()?
+                .map(|s| s as usize)
+        }
+        "edge_margin_mm" => o.edge_margin_mm = f(key)?,
+        "verify_photons" => o.verify_photons = count(v, key, 0)?,
+        "verify_seed" => o.verify_seed = opt(v).then(|| count(v, key, 0)).transpose()?,
+        "threads" => o.threads = opt(v).then(|| threads_arg(v)).transpose()?,
+        "estimator" => o.estimator = choice(key, &v.extract::<String>()?, ESTIMATORS)?,
+        "backend" => o.backend = choice(key, &v.extract::<String>()?, BACKENDS)?,
+        "export_placement" => {
+            o.export_placement = if opt(v) {
+                let name: String = v.extract()?;
+                let printable: Vec<(&str, Placement)> = Placement::ALL
+                    .iter()
+                    .copied()
+                    .filter(|(_, p)| p.printable())
+                    .collect();
+                Some(choice(key, &name, &printable)?)
+            } else {
+                None
+            }
+        }
+        _ => {
+            return Err(PyTypeError::new_err(format!(
+                "optimize() got an unexpected keyword argument '{key}'"
+            )));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,322 @@
+//! `blutrace.Scene`: a loaded, validated scene as a value (copy, get and set by key path),
+//! and the calls that use it: check, trace, optimize.
+
+use crate::convert::{self, choice, count, py_to_toml, run_error, scene_error, toml_to_py};
+use crate::detached::{detached, run_detached};
+use crate::optimization::{self, Optimization};
+use crate::progress;
+use crate::run::Run;
+use blutrace::accel::BackendChoice;
+use blutrace::estimator::Estimator;
+use blutrace::run::{self, Interrupt, Progress, RunOptions, Shard, TargetMetric};
+use blutrace::scene::{Scene as RustScene, key_path};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Spellings of the estimators, as on the command line.
+pub const ESTIMATORS: &[(&str, Estimator)] = &[
+    ("analog", Estimator::Analog),
+    ("weighted", Estimator::Weighted),
+];
+
+/// Spellings of the intersection backends.
+pub const BACKENDS: &[(&str, BackendChoice)] = &[
+    ("auto", BackendChoice::Auto),
+    ("embree", BackendChoice::Embree),
+    ("bvh", BackendChoice::Bvh),
+    ("brute", BackendChoice::Brute),
+];
+
+/// Spellings of the target metrics.
+const TARGET_METRICS: &[(&str, TargetMetric)] = &[
+    ("mean", TargetMetric::Mean),
+    ("efficiency", TargetMetric::Efficiency),
+    ("cv", TargetMetric::Cv),
+    ("nine-point", TargetMetric::NinePoint),
+    ("thirteen-point", TargetMetric::ThirteenPoint),
+    ("bin", TargetMetric::Bin),
+];
+
+/// A validated, traceable scene: a value (``copy()`` gives an independent one).
+///
+/// ``Scene.load(path)`` reads a scene file, or ``scene.toml`` in a folder, and every file it
+/// names; ``Scene.from_toml(text, path)`` builds one from text (geometry relative to
+/// ``path``'s folder). ``get(key)`` and ``set(key, value)`` read and change the scene file's
+/// values by key path: dotted keys and array indices from 0 (``sources.0.center.2``), ``*``
+/// for every element of an array (``sources.*.center.2``); ``set`` loads the scene again
+/// from the edited file, so every check runs. ``check()`` returns what ``blutrace check
+/// --json`` prints.
+#[pyclass(module = "blutrace", name = "Scene")]
+#[derive(Clone)]
+pub struct Scene {
+    /// The scene.
+    pub inner: Arc<RustScene>,
+}
+
+/// The scene file a path names: the path, or `scene.toml` in it when it is a folder.
+fn scene_file(p: &Path) -> PathBuf {
+    if p.is_dir() {
+        p.join("scene.toml")
+    } else {
+        p.to_path_buf()
+    }
+}
+
+#[pymethods]
+impl Scene {
+    /// Load and validate a scene: a scene file or a folder holding `scene.toml`.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
+        let file = scene_file(&path);
+        let scene = detached(py, || RustScene::load(&file))?.map_err(scene_error)?;
+        Ok(Scene {
+            inner: Arc::new(scene),
+        })
+    }
+
+    /// A scene from the text of a scene file; its geometry paths are relative to `path`'s
+    /// folder (the file it stands for).
+    #[staticmethod]
+    pub fn from_toml(py: Python<'_>, text: &str, path: PathBuf) -> PyResult<Scene> {
+        let doc: toml::Value = toml::from_str(text)
+            .map_err(|e| scene_error(anyhow::anyhow!("{}: {e}", path.display())))?;
+        let scene = detached(py, || RustScene::from_source(doc, &path))?.map_err(scene_error)?;
+        Ok(Scene {
+            inner: Arc::new(scene),
+        })
+    }
+
+    /// The scene file as TOML text (the file as written, with any `set` applied).
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(self.inner.source()).map_err(|e| scene_error(e.into()))
+    }
+
+    /// The scene's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+
+    /// The scene file (geometry paths are relative to its folder).
+    #[getter]
+    fn path(&self) -> String {
+        self.inner.path.display().to_string()
+    }
+
+    /// Non-fatal findings of loading.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
+
+    /// The scene file's `[trace] photons`.
+    #[getter]
+    fn default_photons(&self) -> u64 {
+        self.inner.default_photons
+    }
+
+    /// The scene file's `[trace] seed`.
+    #[getter]
+    fn default_seed(&self) -> u64 {
+        self.inner.default_seed
+    }
+
+    /// The content hash shards of one run agree on (hex): the physics, not the name.
+    #[getter]
+    fn content_hash(&self) -> String {
+        format!("{:016x}", self.inner.content_hash())
+    }
+
+    /// The value at a key path such as `sources.0.center.2` (`*` for every element of an
+    /// array, which must then all hold the same value).
+    fn get<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        let v = self
+            .inner
+            .get(key)
+            .map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
+        toml_to_py(py, &v)
+    }
+
+    /// Set the value at a key path (every element a `*` names): the scene is loaded again
+    /// from the edited file, so every check runs (a `SceneError` leaves it unchanged).
+    fn set(&mut self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let value = py_to_toml(value)?;
+        key_path::resolve(self.inner.source(), key).map_err(|e| {
+            PyValueError::new_err(format!("{}: {key}: {e:#}", self.inner.path.display()))
+        })?;
+        let scene = self.inner.clone();
+        let edited = detached(py, || scene.with(key, value))?.map_err(scene_error)?;
+        self.inner = Arc::new(edited);
+        Ok(())
+    }
+
+    /// An independent copy (a `set` on either leaves the other as it is).
+    fn copy(&self) -> Scene {
+        self.clone()
+    }
+
+    fn __copy__(&self) -> Scene {
+        self.clone()
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Scene {
+        self.clone()
+    }
+
+    /// The scene file as a dict (the file as written, with any `set` applied).
+    #[getter]
+    fn source<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        toml_to_py(py, self.inner.source())
+    }
+
+    /// What `blutrace check --json` prints: geometry, tallies, sources, media, warnings.
+    fn check<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let scene = self.inner.clone();
+        let report = detached(py, || {
+            blutrace::scene::check_report::check_json(&scene, &scene.path)
+        })?
+        .map_err(scene_error)?;
+        convert::json_to_py(py, &report)
+    }
+
+    /// Trace the scene and return the `Run`.
+    ///
+    /// ``photons`` defaults to the scene's ``[trace] photons`` (1e9 as a cap when
+    /// ``target_error`` or ``max_time`` is given) and ``seed`` to its ``[trace] seed``;
+    /// ``threads`` defaults to all cores (results do not depend on it); ``estimator`` is
+    /// "analog" or "weighted"; ``target_error`` stops once the relative standard error of
+    /// ``target_metric`` ("mean", "efficiency", "cv", "nine-point", "thirteen-point", "bin") is
+    /// at or below it; ``max_time`` stops after about that many seconds; ``progress`` is True
+    /// (a tqdm bar when tqdm is installed, else a line on stderr) or a callable
+    /// ``(photons_done, photons_total)``; ``shard=(k, m)`` traces only shard k of m of the
+    /// photons, for ``merge``.
+    #[pyo3(signature = (photons=None, seed=None, threads=None, estimator="analog",
+        target_error=None, target_metric="mean", max_time=None, progress=None, shard=None,
+        backend="auto"))]
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &self,
+        py: Python<'_>,
+        photons: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        threads: Option<&Bound<'_, PyAny>>,
+        estimator: &str,
+        target_error: Option<f64>,
+        target_metric: &str,
+        max_time: Option<f64>,
+        progress: Option<&Bound<'_, PyAny>>,
+        shard: Option<(i64, i64)>,
+        backend: &str,
+    ) -> PyResult<Run> {
+        let open_ended = target_error.is_some() || max_time.is_some();
+        let photons = match photons {
+            Some(p) => count(p, "photons", 1)?,
+            None if open_ended => 1_000_000_000,
+            None => self.inner.default_photons,
+        };
+        let shard = shard.map(shard_arg).transpose()?;
+        let options = RunOptions {
+            photons,
+            seed: seed.map_or(Ok(self.inner.default_seed), |s| count(s, "seed", 0))?,
+            threads: threads.map(|t| threads_arg(t)).transpose()?,
+            backend: choice("backend", backend, BACKENDS)?,
+            estimator: choice("estimator", estimator, ESTIMATORS)?,
+            target_error,
+            target_metric: choice("target_metric", target_metric, TARGET_METRICS)?,
+            max_time_s: max_time,
+            shard,
+            convex: true,
+            interrupt: Interrupt::default(),
+        };
+        let (first, last) = options.photon_range();
+        let reporter = progress::reporter(py, progress, last - first)?;
+        let done = AtomicU64::new(0);
+        let scene = self.inner.clone();
+        let traced = run_detached(
+            py,
+            &options.interrupt,
+            || {
+                run::trace(scene, &options, &|p| {
+                    if let Progress::Chunk(n) = p {
+                        done.fetch_add(n, Ordering::Relaxed);
+                    }
+                })
+            },
+            |py| progress::update(py, &reporter, done.load(Ordering::Relaxed)),
+        );
+        // An interrupt or error of the trace outranks one of the progress display.
+        let closed = progress::close(py, &reporter, done.load(Ordering::Relaxed));
+        let run = Run::new(traced?.map_err(run_error)?);
+        closed?;
+        Ok(run)
+    }
+
+    /// Optimize the dot density ("nelder-mead", the default, or "feedback"), or with
+    /// ``vary={"key": (lo, hi)}`` the numbers those key paths name ("nelder-mead" or
+    /// "grid"). The options are those of ``blutrace optimize`` with underscores: ``photons`` (1e6 per design), ``seed``,
+    /// ``max_iter``, ``target_cv``, ``objective`` ("cv", "thirteen-point", "efficiency" or a mix
+    /// "cv=1,efficiency=0.5"), ``grid_points``, ``degree``, ``min_density``, ``max_density``,
+    /// ``tag``, ``initial_step``, ``simplex_tol``, ``alpha``, ``smoothing``, ``dims``, ``cells``,
+    /// ``strips``, ``edge_margin_mm``, ``verify_photons`` (1e7; 0 for none), ``verify_seed``,
+    /// ``threads``, ``estimator``, ``backend``, ``export_placement``; ``progress`` is True (one
+    /// line per iteration on stderr) or a callable taking each iteration's record (a dict).
+    #[pyo3(signature = (method=None, vary=None, **options))]
+    fn optimize(
+        &self,
+        py: Python<'_>,
+        method: Option<&str>,
+        vary: Option<&Bound<'_, PyDict>>,
+        options: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Optimization> {
+        optimization::optimize_scene(py, &self.inner, method, vary, options)
+    }
+
+    /// A scene pickles as its scene file's text and path (`from_toml` restores it).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let cls = py.get_type::<Scene>();
+        let from_toml = cls.getattr("from_toml")?;
+        // Absolute, so a worker started in another folder finds the geometry files.
+        let path =
+            std::path::absolute(&self.inner.path).unwrap_or_else(|_| self.inner.path.clone());
+        let args = (self.to_toml()?, path);
+        PyTuple::new(py, [from_toml, args.into_pyobject(py)?.into_any()])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene(name={:?}, path={:?})",
+            self.inner.name,
+            self.inner.path.display().to_string()
+        )
+    }
+}
+
+/// `shard=(k, m)` checked: 0 <= k < m <= MAX_SHARDS.
+fn shard_arg((index, count): (i64, i64)) -> PyResult<Shard> {
+    if !(0 <= index && index < count && count as u64 <= run::MAX_SHARDS) {
+        return Err(PyValueError::new_err(format!(
+            "shard must be (k, m) with 0 <= k < m <= {}, got ({index}, {count})",
+            run::MAX_SHARDS
+        )));
+    }
+    Ok(Shard {
+        index: index as u64,
+        count: count as u64,
+    })
+}
+
+/// `threads=n` checked: 1..=MAX_THREADS.
+pub fn threads_arg(t: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let n = count(t, "threads", 1)?;
+    if n > run::MAX_THREADS as u64 {
+        return Err(PyValueError::new_err(format!(
+            "threads must be within 1..={}, got {n}",
+            run::MAX_THREADS
+        )));
+    }
+    Ok(n as usize)
+}

@@ -1,0 +1,81 @@
+"""The GIL is released while tracing, and Ctrl-C (a real SIGINT) stops a trace."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import pytest
+
+
+def test_other_python_threads_run_during_a_trace(box):
+    counts = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counts[0] += 1
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        time.sleep(0.05)
+        before = counts[0]
+        start = time.monotonic()
+        box.trace(photons=1e9, max_time=0.5, seed=1)
+        during = counts[0] - before
+        elapsed = time.monotonic() - start
+    finally:
+        stop.set()
+        t.join()
+    assert elapsed >= 0.5
+    # A thread starved by a held GIL counts nothing at all; a free one counts millions.
+    assert during > 10_000, f"the counting thread counted {during} in {elapsed:.2f} s"
+
+
+def interrupted_after(seconds: float, call) -> float:
+    """Send this process a real SIGINT after `seconds` while `call()` runs; assert that it
+    raises KeyboardInterrupt and return how long after the signal it stopped."""
+    assert threading.current_thread() is threading.main_thread()
+    # Python's own Ctrl-C handler, even where the test runner was started with SIGINT
+    # ignored (a background job of a shell).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    try:
+        start = time.monotonic()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            call()
+        return time.monotonic() - start - seconds
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="no SIGINT")
+def test_sigint_stops_a_trace_within_a_second_and_raises(box, tmp_path):
+    # Far more photons than 0.5 s can trace; max_time bounds a failing test.
+    late = interrupted_after(0.5, lambda: box.trace(photons=1e9, max_time=60, seed=1))
+    assert late < 1.5, f"took {late:.2f} s to stop"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="no SIGINT")
+def test_sigint_stops_an_optimization_and_raises(phone):
+    late = interrupted_after(
+        0.5, lambda: phone.optimize(method="feedback", photons=2e7, max_iter=3, verify_photons=0)
+    )
+    assert late < 1.5, f"took {late:.2f} s to stop"
+
+
+def test_an_exception_of_the_progress_callable_stops_the_trace(box):
+    def fail(done, total):
+        if done:
+            raise RuntimeError("stop here")
+
+    start = time.monotonic()
+    with pytest.raises(RuntimeError, match="stop here"):
+        box.trace(photons=1e9, max_time=60, seed=1, progress=fail)
+    assert time.monotonic() - start < 5

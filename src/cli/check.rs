@@ -4,6 +4,7 @@
 use anyhow::Result;
 use blutrace::accel::BackendChoice;
 use blutrace::optics::medium::Medium;
+use blutrace::optics::two_sided;
 use blutrace::scene::Scene;
 use blutrace::scene::geometry_report::BoxMm;
 use std::path::Path;
@@ -88,11 +89,12 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             );
         }
     }
-    for ((tag, model), n) in scene
+    for (t, ((tag, model), n)) in scene
         .tags
         .iter()
         .zip(&scene.surfaces)
         .zip(scene.triangles_per_tag())
+        .enumerate()
     {
         let placement = match model {
             blutrace::optics::surface::SurfaceModel::Dots(d) => {
@@ -100,8 +102,17 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             }
             _ => String::new(),
         };
+        let back = match &scene.backs[t] {
+            Some(b) => format!(", back {}", b.kind()),
+            None => String::new(),
+        };
+        let facing = two_sided::facing(&scene.mesh, t as u32)
+            .iter()
+            .map(|(way, k)| format!("{way} {k}"))
+            .collect::<Vec<_>>()
+            .join(", ");
         say!(
-            "  tag {tag:<20} {:<11} {n} triangles{placement}",
+            "  tag {tag:<20} {:<11} {n} triangles{placement}{back}; facing {facing}",
             model.kind()
         );
     }

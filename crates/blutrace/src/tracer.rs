@@ -28,6 +28,7 @@ use crate::optics::absorber::Absorber;
 use crate::optics::model::Arrival;
 use crate::optics::spectrum::Light;
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
+use crate::optics::two_sided;
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::sources::body::LampBody;
@@ -169,7 +170,7 @@ impl<'a> Tracer<'a> {
             let Some(Hit { surf, struck }) = surf else {
                 return Fate::Escaped;
             };
-            let model = self.model(struck);
+            let model = self.model(struck, true_ray.dir, surf.normal);
             let at = Arrival {
                 media: &scene.media,
                 hit: &surf,
@@ -282,10 +283,15 @@ impl<'a> Tracer<'a> {
         body.expect("only sources with bodies are listed")
     }
 
-    /// The surface model a photon meets.
-    fn model(&self, struck: Struck) -> &SurfaceModel {
+    /// The surface model a photon travelling along `dir` meets at a hit of normal `normal`
+    /// (a two-sided surface's back when it comes from behind).
+    fn model(&self, struck: Struck, dir: glam::DVec3, normal: glam::DVec3) -> &SurfaceModel {
         match struck {
-            Struck::Surface(tag) => &self.scene.surfaces[tag as usize],
+            Struck::Surface(tag) => {
+                let t = tag as usize;
+                let back = self.scene.backs[t].as_ref();
+                two_sided::met(&self.scene.surfaces[t], back, dir, normal)
+            }
             Struck::Body(i) => &self.body(i).model,
             Struck::BodyBack(_) => &SurfaceModel::Absorber(Absorber),
         }

@@ -34,7 +34,7 @@ impl OptimizeResult {
             .surfaces
             .get_mut(&self.tag)
             .with_context(|| format!("{}: no [surfaces.{}]", path.display(), self.tag))?;
-        set_density(surface, &self.final_density)
+        set_density(&mut surface.spec, &self.final_density)
             .with_context(|| format!("{}: [surfaces.{}]", path.display(), self.tag))?;
         let name = file.name.clone().unwrap_or_else(|| {
             base.file_name()
@@ -137,7 +137,7 @@ mod tests {
         let mut file = read_scene_file(&path).unwrap();
         make_paths_absolute(&mut file, &path, path.parent().unwrap()).unwrap();
         assert!(file.geometry.iter().all(|g| g.file.is_absolute()));
-        let spec = file.surfaces.get_mut("lgp_back").unwrap();
+        let spec = &mut file.surfaces.get_mut("lgp_back").unwrap().spec;
         let grid = DensityGrid {
             x_max: 1.0,
             v_min: -2.0,
@@ -165,7 +165,7 @@ mod tests {
                 Density::from_keys(&ctx, "s", back.density_keys(), None, x_max).unwrap();
             assert_eq!(again, density, "{text}");
         }
-        let mut other = file.surfaces.get("lgp_front").unwrap().clone();
+        let mut other = file.surfaces.get("lgp_front").unwrap().spec.clone();
         assert!(set_density(&mut other, &Density::Polynomial(vec![0.1])).is_err());
     }
 }

@@ -4,6 +4,7 @@
 
 use super::Scene;
 use crate::optics::medium::Medium;
+use crate::optics::two_sided;
 use anyhow::Result;
 use std::path::Path;
 
@@ -22,9 +23,31 @@ pub fn check_json(scene: &Scene, scene_file: &Path) -> Result<serde_json::Value>
             "medium": scene.media[s.medium as usize].name,
             "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
         })).collect::<Vec<_>>(),
+        "surfaces": surfaces_json(scene),
         "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),
         "warnings": scene.warnings,
     }))
+}
+
+/// Each tag's model, its back's and which way its triangles face, for `check --json`.
+fn surfaces_json(scene: &Scene) -> Vec<serde_json::Value> {
+    let counts = scene.triangles_per_tag();
+    (0..scene.tags.len())
+        .map(|t| {
+            let facing: serde_json::Map<String, serde_json::Value> =
+                two_sided::facing(&scene.mesh, t as u32)
+                    .into_iter()
+                    .map(|(way, n)| (way.to_string(), n.into()))
+                    .collect();
+            serde_json::json!({
+                "tag": scene.tags[t],
+                "model": scene.surfaces[t].kind(),
+                "back": scene.backs[t].as_ref().map(|b| b.kind()),
+                "triangles": counts[t],
+                "facing": facing,
+            })
+        })
+        .collect()
 }
 
 /// One medium for `check --json`.
@@ -46,7 +69,8 @@ mod tests {
 
     #[test]
     fn the_report_names_the_scene_its_sources_and_media() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bench-box/scene.toml");
+        let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .join("scenes/bench-box/scene.toml");
         let scene = Scene::load(&path).unwrap();
         let r = check_json(&scene, &path).unwrap();
         assert_eq!(r["scene"], scene.name.as_str());

@@ -46,6 +46,7 @@ pub use super::procedural::ProceduralSpec;
 pub use crate::detector::DetectorSpec;
 pub use crate::optics::medium::MediumSpec;
 pub use crate::optics::surface::SurfaceSpec;
+pub use crate::optics::two_sided::SurfaceEntry;
 pub use crate::sources::SourceSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -72,8 +73,8 @@ pub struct SceneFile {
     /// Named media (`air` exists unless redefined).
     #[serde(default)]
     pub media: BTreeMap<String, MediumSpec>,
-    /// Optical model per material tag.
-    pub surfaces: BTreeMap<String, SurfaceSpec>,
+    /// Optical model per material tag (and its back's, [`crate::optics::two_sided`]).
+    pub surfaces: BTreeMap<String, SurfaceEntry>,
     /// Light sources.
     pub sources: Vec<SourceSpec>,
     /// The target plane.

@@ -8,7 +8,7 @@
 //! loaded mesh (vertex coordinates, triangles and tags as little-endian bytes). Not the name, description or the default
 //! photon count and seed.
 
-use super::config::{GeometrySpec, MediumSpec, SceneFile, SourceSpec, SurfaceSpec};
+use super::config::{GeometrySpec, MediumSpec, SceneFile, SourceSpec, SurfaceEntry};
 use crate::geometry::Mesh;
 use anyhow::Result;
 use serde::Serialize;
@@ -20,7 +20,7 @@ use std::path::Path;
 struct Physics<'a> {
     geometry: &'a [GeometrySpec],
     media: &'a BTreeMap<String, MediumSpec>,
-    surfaces: &'a BTreeMap<String, SurfaceSpec>,
+    surfaces: &'a BTreeMap<String, SurfaceEntry>,
     sources: &'a [SourceSpec],
     detector: &'a super::config::DetectorSpec,
     max_bounces: u32,

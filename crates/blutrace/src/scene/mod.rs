@@ -49,6 +49,8 @@ pub struct Scene {
     pub tags: Vec<String>,
     /// Optical model per tag.
     pub surfaces: Vec<SurfaceModel>,
+    /// The model of each tag's back, when it has one ([`crate::optics::two_sided`]).
+    pub backs: Vec<Option<SurfaceModel>>,
     /// Media; index 0 is the ambient medium (air).
     pub media: Vec<Medium>,
     /// Light sources.
@@ -127,13 +129,15 @@ impl Scene {
         let sources = Sources::build(&ctx, &file.sources, &media)?;
         let (mut mesh, tags, geometry) =
             load_geometry(&ctx, file, path, &sources.list, &mut warnings, reads)?;
-        let mut surfaces = Vec::with_capacity(tags.len());
+        let (mut surfaces, mut backs) = (Vec::new(), Vec::new());
         for tag in &tags {
-            let spec = file
+            let entry = file
                 .surfaces
                 .get(tag)
                 .expect("tags are checked against surfaces");
-            surfaces.push(spec.build(&ctx, &format!("surfaces.{tag}"), &media)?);
+            let (front, back) = entry.build(&ctx, &format!("surfaces.{tag}"), &media)?;
+            surfaces.push(front);
+            backs.push(back);
         }
         for unused in file.surfaces.keys().filter(|k| !tags.contains(k)) {
             warnings.push(format!(
@@ -173,6 +177,7 @@ impl Scene {
             mesh: Arc::new(mesh),
             tags,
             surfaces,
+            backs,
             media,
             sources,
             detector,
@@ -210,7 +215,11 @@ impl Scene {
         mesh.positions.iter_mut().for_each(|p| *p -= c);
         self.sources.translate(-c);
         self.detector.origin -= c;
-        for s in &mut self.surfaces {
+        for s in self
+            .surfaces
+            .iter_mut()
+            .chain(self.backs.iter_mut().flatten())
+        {
             s.translate(-c);
         }
         self.offset += c;

@@ -30,34 +30,37 @@
 use super::Emitter;
 use super::body_shape::{BodyHit, BodyShape};
 use crate::geometry::Ray;
-use crate::optics::absorber::Absorber;
 use crate::optics::medium::Medium;
-use crate::optics::surface::{SurfaceModel, SurfaceSpec};
+use crate::optics::opaque::{OpaqueSpec, OpaqueVisitor};
+use crate::optics::surface::SurfaceModel;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 use std::fmt;
 
-/// A source's `body`: a keyword or an opaque surface model.
-#[derive(Clone, Debug, Default)]
+/// A source's `body`: `"transparent"`, or an opaque surface model
+/// ([`OpaqueSpec`]: `"absorber"`, the default, or a model's table).
+#[derive(Clone, Debug)]
 pub enum BodySpec {
-    /// Every photon that meets the body is absorbed (the default).
-    #[default]
-    Absorber,
     /// No body: returning light passes through the lamp.
     Transparent,
-    /// An opaque surface model on the body: any registered model whose light stays on
-    /// its side (lambert, phong, mirror, absorber), with its `[surfaces.*]` fields.
-    Model(Box<SurfaceSpec>),
+    /// An opaque surface model on the body.
+    Opaque(OpaqueSpec),
+}
+
+impl Default for BodySpec {
+    /// Every photon that meets the body is absorbed.
+    fn default() -> Self {
+        BodySpec::Opaque(OpaqueSpec::Absorber)
+    }
 }
 
 impl Serialize for BodySpec {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
-            BodySpec::Absorber => s.serialize_str("absorber"),
             BodySpec::Transparent => s.serialize_str("transparent"),
-            BodySpec::Model(m) => m.serialize(s),
+            BodySpec::Opaque(o) => o.serialize(s),
         }
     }
 }
@@ -68,8 +71,7 @@ impl<'de> Deserialize<'de> for BodySpec {
     }
 }
 
-/// Reads `"absorber"`, `"transparent"` or a table with `model`, with serde's own message
-/// for a bad table (an unknown model or field names itself).
+/// Reads `"transparent"`, or what [`OpaqueSpec`] reads.
 struct BodyVisitor;
 
 impl<'de> Visitor<'de> for BodyVisitor {
@@ -83,15 +85,14 @@ impl<'de> Visitor<'de> for BodyVisitor {
 
     fn visit_str<E: de::Error>(self, v: &str) -> Result<BodySpec, E> {
         match v {
-            "absorber" => Ok(BodySpec::Absorber),
             "transparent" => Ok(BodySpec::Transparent),
+            "absorber" => Ok(BodySpec::Opaque(OpaqueSpec::Absorber)),
             other => Err(E::invalid_value(de::Unexpected::Str(other), &self)),
         }
     }
 
     fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<BodySpec, A::Error> {
-        SurfaceSpec::deserialize(de::value::MapAccessDeserializer::new(map))
-            .map(|s| BodySpec::Model(Box::new(s)))
+        OpaqueVisitor.visit_map(map).map(BodySpec::Opaque)
     }
 }
 
@@ -99,22 +100,10 @@ impl BodySpec {
     /// Check `sources[i].body` (at `at`) and build its surface model (`None`:
     /// transparent): an opaque one, light stays outside the lamp.
     pub fn model(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<Option<SurfaceModel>> {
-        let spec = match self {
-            BodySpec::Transparent => return Ok(None),
-            BodySpec::Absorber => return Ok(Some(SurfaceModel::Absorber(Absorber))),
-            BodySpec::Model(spec) => spec,
-        };
-        let model = spec.build(ctx, at, media)?;
-        if model.interface().is_some() {
-            return Err(ctx.err(
-                &format!("{at}.model"),
-                format!(
-                    "'{}' lets light through; a lamp body is opaque: lambert, phong, mirror or absorber",
-                    model.kind()
-                ),
-            ));
+        match self {
+            BodySpec::Transparent => Ok(None),
+            BodySpec::Opaque(o) => o.build(ctx, at, media, "a lamp body").map(Some),
         }
-        Ok(Some(model))
     }
 }
 
@@ -181,6 +170,7 @@ impl LampBody {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optics::surface::SurfaceSpec;
 
     #[derive(Deserialize, Serialize)]
     struct Holder {
@@ -197,14 +187,14 @@ mod tests {
     fn keywords_and_tables_parse_and_round_trip() {
         assert!(matches!(
             parse(r#"body = "absorber""#),
-            Ok(BodySpec::Absorber)
+            Ok(BodySpec::Opaque(OpaqueSpec::Absorber))
         ));
         assert!(matches!(
             parse(r#"body = "transparent""#),
             Ok(BodySpec::Transparent)
         ));
         let b = parse(r#"body = { model = "lambert", albedo = 0.45 }"#).unwrap();
-        let BodySpec::Model(spec) = &b else {
+        let BodySpec::Opaque(OpaqueSpec::Model(spec)) = &b else {
             panic!("{b:?}")
         };
         let SurfaceSpec::Lambert(l) = spec.as_ref() else {
@@ -214,7 +204,7 @@ mod tests {
         let text = toml::to_string(&Holder { body: b }).unwrap();
         let again = parse(&text).unwrap();
         assert!(
-            matches!(&again, BodySpec::Model(s) if matches!(**s, SurfaceSpec::Lambert(_))),
+            matches!(&again, BodySpec::Opaque(OpaqueSpec::Model(s)) if matches!(**s, SurfaceSpec::Lambert(_))),
             "{again:?}"
         );
     }

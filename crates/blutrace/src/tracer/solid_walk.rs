@@ -34,6 +34,7 @@ use crate::optics::medium::{Interface, MediumId};
 use crate::optics::model::Arrival;
 use crate::optics::spectrum::{Light, Spectral};
 use crate::optics::surface::{Feature, Outcome, SurfaceModel};
+use crate::optics::two_sided;
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Fate};
@@ -210,7 +211,10 @@ impl Tracer<'_> {
                     est: self.estimator,
                     light,
                 };
-                self.scene.surfaces[tag as usize].interact_on(&at, rng)
+                let t = tag as usize;
+                let back = self.scene.backs[t].as_ref();
+                two_sided::met(&self.scene.surfaces[t], back, dir, surf.normal)
+                    .interact_on(&at, rng)
             }
         }
     }

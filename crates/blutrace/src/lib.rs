@@ -1,7 +1,8 @@
 //! blutrace: Monte Carlo photon tracing and optimization of LCD backlight units.
 //!
 //! One module per physical concept: [`scene`] (files and validation), [`geometry`],
-//! [`accel`] (intersection backends), [`optics`] (surface models), [`sources`],
+//! [`accel`] (intersection backends), [`optics`] (surface models), [`color`] (CIE
+//! colorimetry: tables, spectra, XYZ, u'v', CCT), [`sources`],
 //! [`tracer`] (the photon loop), [`detector`] and [`tally`] (what is scored),
 //! [`output`] (EXR, PNG, JSON), [`run`] (a whole traced job with its summary) and
 //! [`optimize`] (the dot and layout searches). The command line is the `blutrace` binary's
@@ -10,6 +11,7 @@
 //! library.
 
 pub mod accel;
+pub mod color;
 pub mod count;
 pub mod detector;
 pub mod estimator;

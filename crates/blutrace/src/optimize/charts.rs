@@ -4,8 +4,8 @@ use super::OptimizeResult;
 use super::objective::Evaluation;
 use crate::optics::dots::{Density, DensityGrid};
 use crate::output::atomic::SetDir;
+use crate::output::map::{Grid, MapOptions, write_map};
 use crate::output::plot::{Chart, Scale, Series, write_chart};
-use crate::output::png::{PreviewOptions, write_false_colour};
 use anyhow::Result;
 use std::path::Path;
 
@@ -15,7 +15,7 @@ impl OptimizeResult {
         out.write_with("density.png", |p| write_chart(p, &self.density_chart()))?;
         out.write_with("profile.png", |p| write_chart(p, &self.profile_chart()))?;
         if let Density::Grid(g) = &self.final_density {
-            out.write_with("density_map.png", |p| write_density_map(p, g))?;
+            out.write_with("density_map.png", |p| self.write_density_map(p, g))?;
         }
         Ok(())
     }
@@ -90,17 +90,59 @@ impl OptimizeResult {
             ],
         }
     }
+
+    /// False-colour map of a 2-D density grid's knots: columns along the axis (left to
+    /// right from the lamp edge), rows across it (the first row at the bottom), each knot
+    /// a cell centred on its position in mm.
+    fn write_density_map(&self, path: &Path, g: &DensityGrid) -> Result<()> {
+        let (nx, ny) = g.shape();
+        let values: Vec<f64> = g.values.iter().flatten().copied().collect();
+        let p = &self.pattern;
+        // The knots span the pattern's length (half of it when mirrored) along the axis.
+        let span = if p.grade.mirror {
+            p.grade.length / 2.0
+        } else {
+            p.grade.length
+        };
+        let grid = Grid {
+            nx,
+            ny,
+            values: &values,
+            x_mm: cells_around(0.0, span, nx),
+            y_mm: cells_around(g.v_min, g.v_min + g.width, ny),
+        };
+        let along = if p.grade.mirror {
+            "distance from the nearer lamp edge (mm)"
+        } else {
+            "distance from the lamp edge (mm)"
+        };
+        let e = match &self.verification {
+            Some(v) => &v.final_design.evaluation,
+            None => &self.best,
+        };
+        let opts = MapOptions {
+            title: format!(
+                "Final dot density on {} ({}): area cv {:.3} at {} photons",
+                self.tag, self.method, e.area_cv, e.photons
+            ),
+            x_label: along.into(),
+            y_label: "position across the axis (mm)".into(),
+            unit: "dot density (area fraction)".into(),
+            min: Some(0.0),
+            ..MapOptions::default()
+        };
+        write_map(path, &grid, &opts)
+    }
 }
 
-/// False-colour map of a 2-D density grid's knots: columns along the axis (left to right
-/// from the lamps), rows across it (the first row at the bottom).
-fn write_density_map(path: &Path, g: &DensityGrid) -> Result<()> {
-    let (nx, ny) = g.shape();
-    let values: Vec<f64> = g.values.iter().flatten().copied().collect();
-    let opts = PreviewOptions {
-        min: Some(0.0),
-        unit: Some("area fraction"),
-        ..PreviewOptions::default()
+/// The span of `n` cells centred on `n` knots evenly spaced from `a` to `b` (one knot: a
+/// cell of width `b - a`, or 1 mm if that is zero, centred on `a`).
+fn cells_around(a: f64, b: f64, n: usize) -> [f64; 2] {
+    let step = if n > 1 {
+        (b - a) / (n - 1) as f64
+    } else {
+        b - a
     };
-    write_false_colour(path, nx, ny, &values, &opts)
+    let half = if step > 0.0 { step / 2.0 } else { 0.5 };
+    [a - half, if n > 1 { b + half } else { a + half }]
 }

@@ -6,20 +6,21 @@
 //! - [`exr`]: multi-channel OpenEXR images (32-bit float or unsigned integer channels,
 //!   lossless ZIP compression) with text and number header attributes, plus a reader for
 //!   the files it writes.
-//! - [`png`]: false-colour previews (viridis colour map with a colour bar) for people.
-//! - [`colormap`]: the viridis colour map; `font`: the 5×7 pixel font of previews and charts.
+//! - [`map`]: false-colour maps (viridis, with a colour bar, title and mm axes) for people.
 //! - [`plot`]: line charts (convergence, optimizer histories).
+//! - [`figure`]: what maps and charts share: the embedded font, the colour map, drawing
+//!   with `plotters` into a buffer; `png`: encoding that buffer as a PNG file.
 //!
-//! Grid convention shared by [`exr`] and [`png`]: a `width × height` grid is a row-major
+//! Grid convention shared by [`exr`] and [`map`]: a `width × height` grid is a row-major
 //! slice, `x` fastest, and grid row 0 is the `y = 0` row (the lowest `y`). Both writers put
 //! grid row 0 at the *bottom* of the image, so that the picture looks like the plot of the
 //! grid with `y` pointing up.
 
 pub mod atomic;
-pub mod colormap;
 pub mod exr;
-pub(crate) mod font;
+pub mod figure;
+pub mod map;
 pub mod plot;
-pub mod png;
+pub(crate) mod png;
 #[cfg(test)]
 mod test_png;

@@ -1,4 +1,4 @@
-//! The run's EXR images, laid out as image tools read them.
+//! The run's images: the EXR files, laid out as image tools read them, and `flux.png`.
 //!
 //! - `flux.exr`: channel `Y` = irradiance on the target plane (W/mm^2 per bin), so that any
 //!   viewer shows a grey image (values ~1e-5: scale it, or use `preview.Y`); layer `stderr`
@@ -24,13 +24,47 @@
 //! (`bin_theta_deg`, `bin_phi_deg`). All are EXR `string`s holding numbers in Rust's
 //! shortest round-trip form: exact, and read by every tool (OpenEXR's Python module's old
 //! `InputFile` API returns `None` for `double` attributes).
+//!
+//! `flux.png` is the flux map for people: false colour over the detector in mm from its
+//! origin corner, titled with the scene, the photons and the extraction efficiency (all
+//! exact, so the picture of a run and of its merged shards are the same bytes).
 
 use super::RunResult;
 use super::metrics::{self, Map};
 use crate::output::atomic::SetDir;
 use crate::output::exr::{Attribute, Samples, write_channels};
+use crate::output::map::{Grid, MapOptions, write_map};
 use anyhow::Result;
 use glam::DVec3;
+use std::path::Path;
+
+/// `flux.png`: the map `flux` over the detector, titled with the scene, photons and
+/// extraction efficiency.
+pub(super) fn write_flux_png(run: &RunResult, path: &Path, flux: &Map) -> Result<()> {
+    let d = &run.scene.detector;
+    let l = &run.tally.ledger;
+    let (efficiency, _) = l.detected.mean_and_stderr(l.photons);
+    let grid = Grid {
+        nx: flux.nx,
+        ny: flux.ny,
+        values: &flux.value,
+        x_mm: [0.0, d.size[0]],
+        y_mm: [0.0, d.size[1]],
+    };
+    let opts = MapOptions {
+        title: format!(
+            "{}: {} photons, extraction efficiency {:.2} %",
+            run.scene.name,
+            l.photons,
+            100.0 * efficiency
+        ),
+        x_label: "detector u (mm)".into(),
+        y_label: "detector v (mm)".into(),
+        unit: "irradiance (W/mm²)".into(),
+        ..MapOptions::default()
+    };
+    write_map(path, &grid, &opts)
+}
 
 /// `flux.exr` of the map `flux`.
 pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Result<()> {

@@ -27,10 +27,7 @@ pub mod summary;
 
 use crate::accel::{self, BackendChoice};
 use crate::optics::surface::Estimator;
-use crate::output::{
-    self,
-    atomic::{OutputSet, SetDir},
-};
+use crate::output::atomic::{OutputSet, SetDir};
 use crate::scene::{Scene, SharedScene};
 use crate::tally::Tally;
 use crate::tracer::{CHUNK, Tracer};
@@ -460,20 +457,7 @@ impl RunResult {
         let flux = self.flux_map();
         images::write_flux_exr(self, staged, &flux)?;
         images::write_angular_exr(self, staged)?;
-        let d = &self.scene.detector;
-        staged.write_with("flux.png", |png| {
-            output::png::write_false_colour(
-                png,
-                flux.nx,
-                flux.ny,
-                &flux.value,
-                &output::png::PreviewOptions {
-                    extent_mm: Some(d.size),
-                    unit: Some("W/mm^2"),
-                    ..Default::default()
-                },
-            )
-        })?;
+        staged.write_with("flux.png", |png| images::write_flux_png(self, png, &flux))?;
         staged.write_bytes(
             "convergence.csv",
             summary::convergence_csv(&self.history).as_bytes(),

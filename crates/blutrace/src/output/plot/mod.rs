@@ -1,37 +1,41 @@
-//! Line charts as PNG images, for people to look at.
+//! Line charts as PNG images, for people to look at, drawn with `plotters`.
 //!
 //! [`write_chart`] draws a [`Chart`] — a few [`Series`] of `(x, y)` points — as an
-//! 800×560 pixel PNG: white background, a framed plot area with light grid lines, numeric
-//! tick labels, axis labels, a title and a legend, all written with the built-in 5×7 pixel
-//! font of the `font` module. Each axis is linear or logarithmic ([`Scale`]); its range is
-//! chosen automatically from the data with a small margin.
+//! 800×560 pixel PNG: white background, a title, a framed plot area with light grid
+//! lines, numeric tick labels, axis descriptions and a legend, in the embedded font of
+//! [`super::figure`]. Each axis is linear or logarithmic ([`Scale`]); its range is chosen
+//! from the data.
 //!
-//! - Linear axes get about 5 (3–7) "nice" ticks: multiples of 1, 2, 2.5 or 5 times a power
-//!   of ten.
-//! - Logarithmic axes get ticks at powers of ten labelled like `1e-3` (only every n-th
-//!   power when there are many) and always show at least two of them. Up to 6 decades get
-//!   minor ticks at 2–9 times a power of ten; up to 2.5 decades get labels at 2 and 5
-//!   times a power of ten too (`2e-3`, `5e-3`).
-//! - Series are drawn as 2 pixel wide polylines (optionally dashed, optionally with a
-//!   marker at every point) in the colours of the Tableau 10 palette, in order. Markers
-//!   also differ in shape between series.
+//! - A linear axis spans the data with 5 % to spare on each side; a single value gets
+//!   ±10 % of it (±1 around zero). `plotters` picks "nice" ticks (1, 2, 5 times a power
+//!   of ten).
+//! - A logarithmic axis spans whole decades around the data (so its ends are labelled
+//!   powers of ten), with light grid lines between them.
+//! - Series are 2 pixel wide lines (optionally dashed, optionally with a marker at every
+//!   point) in the colours of the Tableau 10 palette, in order; markers also differ in
+//!   shape between series.
 //! - Points with a non-finite coordinate, or a non-positive one on a logarithmic axis, are
 //!   skipped, and the line is interrupted there; a point left alone gets a marker.
-//! - A single point or a constant coordinate gets a range of ±10 % of the value (±1 around
-//!   zero) on a linear axis, and ±½ decade on a logarithmic one.
-//! - The legend goes into the corner of the plot area that hides the least data.
+//! - The legend stands right of the plot area, so it hides no data.
+//! - With nothing to draw, the chart is a framed placeholder with the title and the reason.
 
+use std::ops::Range;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail, ensure};
+use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::font::{descends, format_label, glyph};
+use super::figure::{
+    Area, DESC_SIZE, FRAME, LABEL_SIZE, TITLE_SIZE, drawing, format_label, render, series_colour,
+    text, text_width,
+};
 use super::png::encode;
-use axis::{Axis, transform};
-use canvas::{Canvas, SHAPES};
+use glyph::Glyph;
 
-mod axis;
-mod canvas;
+mod glyph;
+mod legend;
 
 /// How an axis maps data values to positions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -85,6 +89,19 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// Image size in pixels.
+const WIDTH: u32 = 800;
+const HEIGHT: u32 = 560;
+/// Blank border around everything.
+const PAD: u32 = 14;
+/// Length of tick marks; `plotters` puts labels twice as far from the axis.
+const TICK: u32 = 5;
+/// Space between the plot area and the legend right of it.
+const LEGEND_GAP: u32 = 16;
+/// Tick labels wanted on the horizontal and the vertical axis.
+const X_TICKS: usize = 8;
+const Y_TICKS: usize = 8;
+
 /// Write `chart` as an 800×560 pixel PNG file to `path` (overwriting it).
 ///
 /// A chart never costs a run its results: when there is nothing to draw (no series, no
@@ -93,7 +110,7 @@ pub struct Chart {
 /// the reason. Fails only if the file cannot be written.
 pub fn write_chart(path: &Path, chart: &Chart) -> Result<()> {
     let what = || format!("cannot write chart {}", path.display());
-    let r = render(chart).unwrap_or_else(|why| placeholder(chart, &format!("{why:#}")));
+    let (rgb, _) = render_chart(chart).with_context(what)?;
     let labels: Vec<&str> = chart.series.iter().map(|s| s.label.as_str()).collect();
     let comment = format!(
         "line chart {:?}: x = {:?} ({:?}), y = {:?} ({:?}); series: {}",
@@ -104,393 +121,279 @@ pub fn write_chart(path: &Path, chart: &Chart) -> Result<()> {
         chart.y_scale,
         labels.join(", ")
     );
-    encode(path, r.width as u32, r.height as u32, &r.rgb, &comment).with_context(what)
+    encode(path, WIDTH, HEIGHT, &rgb, &comment).with_context(what)
 }
 
-/// Image size in pixels.
-const WIDTH: i64 = 800;
-const HEIGHT: i64 = 560;
+/// A rectangle of pixels: `(columns, rows)`, ends excluded.
+type PixelRect = (Range<i32>, Range<i32>);
 
-const BACKGROUND: [u8; 3] = [255, 255, 255];
-const INK: [u8; 3] = [0, 0, 0];
-const FRAME: [u8; 3] = [64, 64, 64];
-const GRID_MAJOR: [u8; 3] = [222, 222, 222];
-const GRID_MINOR: [u8; 3] = [240, 240, 240];
-const LEGEND_FRAME: [u8; 3] = [160, 160, 160];
-
-/// The Tableau 10 palette (Tableau's 2016 default), in order.
-const PALETTE: [[u8; 3]; 10] = [
-    [78, 121, 167],  // blue
-    [242, 142, 43],  // orange
-    [225, 87, 89],   // red
-    [118, 183, 178], // teal
-    [89, 161, 79],   // green
-    [237, 201, 72],  // yellow
-    [176, 122, 161], // purple
-    [255, 157, 167], // pink
-    [156, 117, 95],  // brown
-    [186, 176, 172], // grey
-];
-
-/// Colour of series `i`.
-fn series_colour(i: usize) -> [u8; 3] {
-    PALETTE[i % PALETTE.len()]
-}
-
-/// Font magnification: each font pixel is a `FONT_SCALE²` block.
-const FONT_SCALE: i64 = 2;
-/// Horizontal advance of one character (5 pixels + 1 pixel spacing).
-const CHAR_W: i64 = 6 * FONT_SCALE;
-/// Height of one character.
-const CHAR_H: i64 = 7 * FONT_SCALE;
-/// Blank border around everything.
-const MARGIN: i64 = 12;
-/// Length of the major tick marks outside the plot area (minor ones are half as long).
-const TICK: i64 = 6;
-/// Space between a tick mark and its label.
-const TICK_GAP: i64 = 5;
-/// Space between tick labels and the axis label.
-const LABEL_GAP: i64 = 12;
-/// Top of the plot area (room for the title).
-const PLOT_TOP: i64 = MARGIN + CHAR_H + 16;
-/// Dash pattern of dashed lines: drawn for `DASH_ON` pixels, then blank up to `DASH_PERIOD`.
-const DASH_ON: f64 = 10.0;
-const DASH_PERIOD: f64 = 16.0;
-/// Half the size of a marker.
-const MARKER_R: i64 = 4;
-/// Length of the line sample in the legend.
-const LEGEND_SAMPLE: i64 = 36;
-/// Height of one legend row.
-const LEGEND_ROW: i64 = 20;
-/// Padding inside the legend box, and its distance from the plot frame.
-const LEGEND_PAD: i64 = 8;
-
-/// Pixel width of `text` in the font (no trailing spacing).
-fn text_width(text: &str) -> i64 {
-    let n = text.chars().count() as i64;
-    (n * CHAR_W - FONT_SCALE).max(0)
-}
-
-/// The set font pixels of `text` as `(column, row)` in font pixels: column 0 is the left
-/// edge of the first character (6 columns per character), row 0 the top of the cell (rows
-/// 0–6, and 7 for the tails of [`descends`] letters).
-fn font_pixels(text: &str) -> impl Iterator<Item = (i64, i64)> + '_ {
-    text.chars().enumerate().flat_map(|(i, ch)| {
-        let drop = i64::from(descends(ch));
-        glyph(ch)
-            .into_iter()
-            .enumerate()
-            .flat_map(move |(gy, bits)| {
-                (0..5)
-                    .filter(move |gx| bits & (0b10000 >> gx) != 0)
-                    .map(move |gx| (6 * i as i64 + gx, gy as i64 + drop))
-            })
-    })
-}
-
-/// A rectangle of pixels `[x, x + w) × [y, y + h)`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Rect {
-    x: i64,
-    y: i64,
-    w: i64,
-    h: i64,
-}
-
-impl Rect {
-    const fn new(x: i64, y: i64, w: i64, h: i64) -> Self {
-        Self { x, y, w, h }
-    }
-
-    fn contains(&self, x: i64, y: i64) -> bool {
-        x >= self.x && x < self.x + self.w && y >= self.y && y < self.y + self.h
-    }
-
-    /// The pixel column of the horizontal fraction `f` (0 = left edge, 1 = right edge).
-    fn px(&self, f: f64) -> f64 {
-        self.x as f64 + f * (self.w - 1) as f64
-    }
-
-    /// The pixel row of the vertical fraction `f` (0 = bottom edge, 1 = top edge).
-    fn py(&self, f: f64) -> f64 {
-        self.y as f64 + (1.0 - f) * (self.h - 1) as f64
-    }
-}
-
-/// The legend: its box and, per entry, the series index and the vertical centre of its row.
-#[derive(Clone, Debug, PartialEq)]
-struct Legend {
-    rect: Rect,
-    rows: Vec<(usize, i64)>,
-}
-
-/// A rendered chart, with the geometry the tests need.
-#[cfg_attr(
-    not(test),
-    allow(dead_code, reason = "geometry read by the tests only")
-)]
-struct Rendered {
-    width: i64,
-    height: i64,
-    rgb: Vec<u8>,
-    plot: Rect,
-    x: Axis,
-    y: Axis,
-    legend: Option<Legend>,
-}
-
-/// The data range `(min, max)` in axis units of the drawable points of `chart`.
-fn data_ranges(chart: &Chart) -> Option<((f64, f64), (f64, f64))> {
-    let mut r: Option<((f64, f64), (f64, f64))> = None;
-    for s in &chart.series {
-        for &(x, y) in &s.points {
-            let (Some(x), Some(y)) = (transform(chart.x_scale, x), transform(chart.y_scale, y))
-            else {
-                continue;
-            };
-            r = Some(match r {
-                None => ((x, x), (y, y)),
-                Some(((x0, x1), (y0, y1))) => ((x0.min(x), x1.max(x)), (y0.min(y), y1.max(y))),
-            });
+/// The pixels of `chart` (or of its placeholder), and its plot area (None: placeholder).
+fn render_chart(chart: &Chart) -> Result<(Vec<u8>, Option<PixelRect>)> {
+    match axis_ranges(chart) {
+        Ok(ranges) => {
+            let mut plot = None;
+            let rgb = render((WIDTH, HEIGHT), |root| {
+                plot = Some(draw_chart(root, chart, ranges)?);
+                Ok(())
+            })?;
+            Ok((rgb, plot))
+        }
+        Err(why) => {
+            let why = format!("{why:#}");
+            let rgb = render((WIDTH, HEIGHT), |root| placeholder(root, chart, &why))?;
+            Ok((rgb, None))
         }
     }
-    r
 }
 
-/// A chart with nothing to draw: its frame, its title and why, wrapped to the width.
-fn placeholder(chart: &Chart, why: &str) -> Rendered {
-    let mut canvas = Canvas::new(WIDTH, HEIGHT, BACKGROUND);
-    let plot = Rect::new(
-        MARGIN,
-        PLOT_TOP,
-        WIDTH - 2 * MARGIN,
-        HEIGHT - PLOT_TOP - MARGIN,
-    );
-    canvas.frame(plot, FRAME);
-    let centred = |canvas: &mut Canvas, y: i64, line: &str| {
-        canvas.text((WIDTH - text_width(line)) / 2, y, line, INK);
-    };
-    centred(&mut canvas, MARGIN / 2, &chart.title);
-    let mut lines = vec![String::from("nothing to draw:")];
-    let max_chars = ((plot.w - 40) / text_width("m").max(1)) as usize;
-    for word in why.split_whitespace() {
-        let last = lines.last_mut().expect("one line at least");
-        if last.len() + 1 + word.len() > max_chars && !last.is_empty() {
-            lines.push(word.to_string());
-        } else {
-            if !last.is_empty() {
-                last.push(' ');
-            }
-            last.push_str(word);
-        }
-    }
-    let top = plot.y + plot.h / 2 - (lines.len() as i64 * (CHAR_H + 6)) / 2;
-    for (k, line) in lines.iter().enumerate() {
-        centred(&mut canvas, top + k as i64 * (CHAR_H + 6), line);
-    }
-    Rendered {
-        width: WIDTH,
-        height: HEIGHT,
-        rgb: canvas.rgb,
-        plot,
-        x: Axis::fit(Scale::Linear, 0.0, 1.0).expect("a unit axis fits"),
-        y: Axis::fit(Scale::Linear, 0.0, 1.0).expect("a unit axis fits"),
-        legend: None,
+/// The position of `v` on an axis of `scale`, or None if it cannot be drawn there.
+fn transform(scale: Scale, v: f64) -> Option<f64> {
+    match scale {
+        Scale::Linear => v.is_finite().then_some(v),
+        Scale::Log10 => (v.is_finite() && v > 0.0).then(|| v.log10()),
     }
 }
 
-/// Draw `chart`.
-fn render(chart: &Chart) -> Result<Rendered> {
+/// The drawable points of `chart`: `(x, y)` with both coordinates drawable.
+fn drawable(chart: &Chart) -> impl Iterator<Item = (f64, f64)> + '_ {
+    chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .filter(|&(x, y)| {
+            transform(chart.x_scale, x).is_some() && transform(chart.y_scale, y).is_some()
+        })
+}
+
+/// The axis ranges (data values) of `chart`; an error says why there is nothing to draw.
+fn axis_ranges(chart: &Chart) -> Result<((f64, f64), (f64, f64))> {
     if chart.series.is_empty() {
         bail!("chart {:?} has no series", chart.title);
     }
-    let Some(((x_min, x_max), (y_min, y_max))) = data_ranges(chart) else {
+    let mut points = drawable(chart).peekable();
+    if points.peek().is_none() {
         bail!(
             "chart {:?} has no drawable point (every point has a non-finite coordinate, or a \
              non-positive one on a logarithmic axis)",
             chart.title
         );
-    };
-    let x = Axis::fit(chart.x_scale, x_min, x_max).context("horizontal axis")?;
-    let y = Axis::fit(chart.y_scale, y_min, y_max).context("vertical axis")?;
-
-    // Layout: the y tick labels set the left edge of the plot area, the last x tick label
-    // the right edge.
-    let y_ticks = y.ticks(9);
-    let x_ticks = x.ticks(8);
-    let y_label_w = y_ticks
-        .iter()
-        .filter_map(|t| t.label.as_deref().map(text_width))
-        .max()
-        .unwrap_or(0);
-    let y_axis_label_w = if chart.y_label.is_empty() {
-        0
-    } else {
-        CHAR_H + LABEL_GAP
-    };
-    let left = MARGIN + y_axis_label_w + y_label_w + TICK_GAP + TICK;
-    let last_x_label_w = x_ticks
-        .iter()
-        .rev()
-        .find_map(|t| t.label.as_deref().map(text_width))
-        .unwrap_or(0);
-    let right = WIDTH - MARGIN.max(last_x_label_w / 2 + 4) - 8;
-    let x_axis_label_h = if chart.x_label.is_empty() {
-        0
-    } else {
-        CHAR_H + LABEL_GAP
-    };
-    let bottom = HEIGHT - (MARGIN + x_axis_label_h + CHAR_H + TICK_GAP + TICK);
-    let plot = Rect::new(left, PLOT_TOP, right - left, bottom - PLOT_TOP);
-
-    let mut canvas = Canvas::new(WIDTH, HEIGHT, BACKGROUND);
-
-    // Grid lines, minor ones first.
-    for major in [false, true] {
-        let colour = if major { GRID_MAJOR } else { GRID_MINOR };
-        for t in x_ticks.iter().filter(|t| t.label.is_some() == major) {
-            let px = plot.px(t.frac).round() as i64;
-            canvas.fill_rect(Rect::new(px, plot.y, 1, plot.h), colour);
-        }
-        for t in y_ticks.iter().filter(|t| t.label.is_some() == major) {
-            let py = plot.py(t.frac).round() as i64;
-            canvas.fill_rect(Rect::new(plot.x, py, plot.w, 1), colour);
-        }
     }
-
-    // The series, clipped to the plot area.
-    canvas.clip = plot;
-    for (i, s) in chart.series.iter().enumerate() {
-        let colour = series_colour(i);
-        let pixel = |&(vx, vy): &(f64, f64)| -> Option<(i64, i64)> {
-            let (fx, fy) = (x.frac(vx)?, y.frac(vy)?);
-            Some((plot.px(fx).round() as i64, plot.py(fy).round() as i64))
-        };
-        let mapped: Vec<Option<(i64, i64)>> = s.points.iter().map(pixel).collect();
-        for run in mapped.split(Option::is_none) {
-            let run: Vec<(i64, i64)> = run.iter().flatten().copied().collect();
-            match run.len() {
-                0 => {}
-                // A lone point gets a marker even without `markers`.
-                1 => canvas.marker(SHAPES[i % SHAPES.len()], run[0].0, run[0].1, colour),
-                _ => canvas.polyline(&run, colour, s.dashed),
-            }
-        }
-        if s.markers {
-            for &(px, py) in mapped.iter().flatten() {
-                canvas.marker(SHAPES[i % SHAPES.len()], px, py, colour);
-            }
-        }
-    }
-    canvas.clip = canvas.full();
-
-    // Frame, ticks and tick labels.
-    canvas.frame(plot, FRAME);
-    let plot_bottom = plot.y + plot.h;
-    let mut free_x = i64::MIN; // labels must not start left of this
-    for t in &x_ticks {
-        let px = plot.px(t.frac).round() as i64;
-        let len = if t.label.is_some() { TICK } else { TICK / 2 };
-        canvas.fill_rect(Rect::new(px, plot_bottom + 1, 1, len), FRAME);
-        if let Some(label) = &t.label {
-            let (w, top) = (text_width(label), plot_bottom + 1 + TICK + TICK_GAP);
-            if px - w / 2 >= free_x {
-                canvas.text(px - w / 2, top, label, INK);
-                free_x = px - w / 2 + w + CHAR_W;
-            }
-        }
-    }
-    for t in &y_ticks {
-        let py = plot.py(t.frac).round() as i64;
-        let len = if t.label.is_some() { TICK } else { TICK / 2 };
-        canvas.fill_rect(Rect::new(plot.x - 1 - len, py, len, 1), FRAME);
-        if let Some(label) = &t.label {
-            let right = plot.x - 1 - TICK - TICK_GAP;
-            canvas.text(right - text_width(label), py - CHAR_H / 2, label, INK);
-        }
-    }
-
-    // Axis labels and title, centred on the plot area as far as the image allows (text
-    // too long for the image starts at the left margin and is cut off).
-    let centred = |w: i64| {
-        let x0 = plot.x + (plot.w - w) / 2;
-        x0.min(WIDTH - MARGIN - w).max(MARGIN)
-    };
-    if !chart.x_label.is_empty() {
-        let w = text_width(&chart.x_label);
-        let top = HEIGHT - MARGIN - CHAR_H;
-        canvas.text(centred(w), top, &chart.x_label, INK);
-    }
-    if !chart.y_label.is_empty() {
-        let w = text_width(&chart.y_label);
-        let bottom = (plot.y + (plot.h + w) / 2).min(HEIGHT - 1).max(w);
-        canvas.text_up(MARGIN, bottom, &chart.y_label, INK);
-    }
-    if !chart.title.is_empty() {
-        let w = text_width(&chart.title);
-        let x0 = centred(w);
-        // Bold: the title twice, one pixel apart.
-        canvas.text(x0, MARGIN, &chart.title, INK);
-        canvas.text(x0 + 1, MARGIN, &chart.title, INK);
-    }
-
-    let legend = draw_legend(&mut canvas, chart, plot);
-    Ok(Rendered {
-        width: WIDTH,
-        height: HEIGHT,
-        rgb: canvas.rgb,
-        plot,
-        x,
-        y,
-        legend,
-    })
+    let span = |lo: (f64, f64), (x, y): (f64, f64)| (lo.0.min(x), lo.1.max(y));
+    let init = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
+    let (xs, ys) = points.fold(init, |(xs, ys), (x, y)| {
+        (span(xs, (x, x)), span(ys, (y, y)))
+    });
+    let x = axis_range(chart.x_scale, xs).context("horizontal axis")?;
+    let y = axis_range(chart.y_scale, ys).context("vertical axis")?;
+    Ok((x, y))
 }
 
-/// Draw the legend in the corner of `plot` covering the fewest data pixels (ties: top
-/// right, top left, bottom right, bottom left); `None` if no series has a label.
-fn draw_legend(canvas: &mut Canvas, chart: &Chart, plot: Rect) -> Option<Legend> {
-    let entries: Vec<usize> = (0..chart.series.len())
-        .filter(|&i| !chart.series[i].label.is_empty())
-        .collect();
-    let label_w = entries
-        .iter()
-        .map(|&i| text_width(&chart.series[i].label))
-        .max()?;
-    let w = (LEGEND_PAD + LEGEND_SAMPLE + LEGEND_PAD + label_w + LEGEND_PAD)
-        .min(plot.w - 2 * LEGEND_PAD);
-    let h = (2 * LEGEND_PAD + entries.len() as i64 * LEGEND_ROW - (LEGEND_ROW - CHAR_H))
-        .min(plot.h - 2 * LEGEND_PAD);
-    let (x_left, x_right) = (plot.x + LEGEND_PAD, plot.x + plot.w - LEGEND_PAD - w);
-    let (y_top, y_bottom) = (plot.y + LEGEND_PAD, plot.y + plot.h - LEGEND_PAD - h);
-    let rect = [
-        (x_right, y_top),
-        (x_left, y_top),
-        (x_right, y_bottom),
-        (x_left, y_bottom),
-    ]
-    .into_iter()
-    .map(|(x, y)| Rect::new(x, y, w, h))
-    .min_by_key(|&r| canvas.busy_pixels(r))?;
-
-    canvas.fill_rect(rect, BACKGROUND);
-    canvas.frame(rect, LEGEND_FRAME);
-    canvas.clip = rect;
-    let mut rows = Vec::new();
-    for (row, &i) in entries.iter().enumerate() {
-        let s = &chart.series[i];
-        let colour = series_colour(i);
-        let top = rect.y + LEGEND_PAD + row as i64 * LEGEND_ROW;
-        let cy = top + CHAR_H / 2 - 1;
-        let x0 = rect.x + LEGEND_PAD;
-        canvas.polyline(&[(x0, cy), (x0 + LEGEND_SAMPLE - 2, cy)], colour, s.dashed);
-        if s.markers {
-            canvas.marker(SHAPES[i % SHAPES.len()], x0 + LEGEND_SAMPLE / 2, cy, colour);
+/// The range an axis of `scale` shows for data spanning `(lo, hi)`.
+fn axis_range(scale: Scale, (lo, hi): (f64, f64)) -> Result<(f64, f64)> {
+    let (a, b) = match scale {
+        Scale::Linear if hi > lo => (lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)),
+        Scale::Linear if lo == 0.0 => (-1.0, 1.0),
+        Scale::Linear => (lo - 0.1 * lo.abs(), lo + 0.1 * lo.abs()),
+        Scale::Log10 => {
+            let (a, b) = (lo.log10().floor(), hi.log10().ceil());
+            let (a, b) = if b > a { (a, b) } else { (a - 0.5, b + 0.5) };
+            // A hair wider, so that rounding in `plotters` keeps the end decades labelled.
+            (10f64.powf(a) * (1.0 - 1e-9), 10f64.powf(b) * (1.0 + 1e-9))
         }
-        canvas.text(x0 + LEGEND_SAMPLE + LEGEND_PAD, top, &s.label, INK);
-        rows.push((i, cy));
+    };
+    ensure!(
+        a.is_finite() && b.is_finite() && (b - a).is_finite() && b > a,
+        "the data range {lo} to {hi} is too wide to draw"
+    );
+    Ok((a, b))
+}
+
+/// Draw `chart` over the axis ranges `(x, y)`; returns the plot area.
+fn draw_chart(root: &Area, chart: &Chart, (x, y): ((f64, f64), (f64, f64))) -> Result<PixelRect> {
+    let lin = |(a, b): (f64, f64)| a..b;
+    let log = |(a, b): (f64, f64)| (a..b).log_scale();
+    match (chart.x_scale, chart.y_scale) {
+        (Scale::Linear, Scale::Linear) => draw_axes(root, chart, lin(x), lin(y)),
+        (Scale::Linear, Scale::Log10) => draw_axes(root, chart, lin(x), log(y)),
+        (Scale::Log10, Scale::Linear) => draw_axes(root, chart, log(x), lin(y)),
+        (Scale::Log10, Scale::Log10) => draw_axes(root, chart, log(x), log(y)),
     }
-    canvas.clip = canvas.full();
-    Some(Legend { rect, rows })
+}
+
+/// The widest tick label of `coord` (pixels) and the last one's width.
+fn label_widths<C: Ranged<ValueType = f64>>(root: &Area, coord: &C, n: usize) -> (u32, u32) {
+    let style = text(LABEL_SIZE);
+    let widths: Vec<u32> = coord
+        .key_points(n)
+        .iter()
+        .map(|v| text_width(root, &format_label(*v), &style))
+        .collect();
+    (
+        widths.iter().copied().max().unwrap_or(0),
+        widths.last().copied().unwrap_or(0),
+    )
+}
+
+/// Draw the chart on the axes `x` and `y` (linear or logarithmic ranges).
+fn draw_axes<X, Y>(root: &Area, chart: &Chart, x: X, y: Y) -> Result<PixelRect>
+where
+    X: AsRangedCoord<Value = f64> + Clone,
+    Y: AsRangedCoord<Value = f64> + Clone,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let (xc, yc): (X::CoordDescType, Y::CoordDescType) = (x.clone().into(), y.clone().into());
+    let (y_label_w, _) = label_widths(root, &yc, Y_TICKS);
+    let (_, last_x_w) = label_widths(root, &xc, X_TICKS);
+    let desc_h = root
+        .estimate_text_size("Ay", &text(DESC_SIZE))
+        .map_or(0, |(_, h)| h);
+    let label_h = root
+        .estimate_text_size("0", &text(LABEL_SIZE))
+        .map_or(0, |(_, h)| h);
+    let y_area = 2 * TICK
+        + y_label_w
+        + 8
+        + if chart.y_label.is_empty() {
+            0
+        } else {
+            desc_h + 6
+        };
+    let x_area = 2 * TICK
+        + label_h
+        + 8
+        + if chart.x_label.is_empty() {
+            0
+        } else {
+            desc_h + 6
+        };
+    // Right of the plot: the legend, or room for the last x tick label.
+    let right = match legend::width(root, chart) {
+        0 => PAD.max(last_x_w / 2 + 6),
+        w => w + LEGEND_GAP + PAD,
+    };
+    let mut c = ChartBuilder::on(root)
+        .caption(&chart.title, text(TITLE_SIZE))
+        .margin(PAD)
+        .margin_right(right)
+        .x_label_area_size(x_area)
+        .y_label_area_size(y_area)
+        .build_cartesian_2d(x, y)
+        .map_err(drawing)?;
+    let fmt = |v: &f64| format_label(*v);
+    c.configure_mesh()
+        .x_labels(X_TICKS)
+        .y_labels(Y_TICKS)
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
+        .set_all_tick_mark_size(TICK)
+        .bold_line_style(RGBColor(222, 222, 222))
+        .light_line_style(RGBColor(242, 242, 242))
+        .max_light_lines(4)
+        .label_style(text(LABEL_SIZE))
+        .axis_desc_style(text(DESC_SIZE))
+        .axis_style(FRAME)
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .draw()
+        .map_err(drawing)?;
+    for (i, s) in chart.series.iter().enumerate() {
+        draw_series(&mut c, chart, i, s)?;
+    }
+    let (xs, ys) = c.plotting_area().get_pixel_range();
+    legend::draw(root, chart, (xs.end + LEGEND_GAP as i32, ys.start))?;
+    let r = [(xs.start, ys.start), (xs.end - 1, ys.end - 1)];
+    root.draw(&Rectangle::new(r, FRAME.stroke_width(1)))
+        .map_err(drawing)?;
+    Ok((xs, ys))
+}
+
+/// The chart context `draw_axes` draws series into.
+type Ctx<'a, 'b, X, Y> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<X, Y>>;
+
+/// Draw series `i`: its runs of drawable points as lines, and its markers.
+fn draw_series<'a, 'b: 'a, X, Y>(
+    c: &mut Ctx<'a, 'b, X, Y>,
+    chart: &Chart,
+    i: usize,
+    s: &Series,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = series_colour(i).stroke_width(2);
+    let ok = |&(x, y): &(f64, f64)| {
+        transform(chart.x_scale, x).is_some() && transform(chart.y_scale, y).is_some()
+    };
+    let runs: Vec<Vec<(f64, f64)>> = s
+        .points
+        .split(|p| !ok(p))
+        .filter(|r| !r.is_empty())
+        .map(<[_]>::to_vec)
+        .collect();
+    for run in &runs {
+        if run.len() == 1 && !s.markers {
+            c.draw_series([marker(i, run[0], style)]).map_err(drawing)?;
+        } else if s.dashed {
+            c.draw_series(DashedLineSeries::new(run.iter().copied(), 10, 6, style))
+                .map_err(drawing)?;
+        } else {
+            c.draw_series(LineSeries::new(run.iter().copied(), style))
+                .map_err(drawing)?;
+        }
+        if s.markers {
+            c.draw_series(run.iter().map(|&p| marker(i, p, style)))
+                .map_err(drawing)?;
+        }
+    }
+    Ok(())
+}
+
+/// The marker of series `i` at the data point `at`.
+fn marker(i: usize, at: (f64, f64), style: ShapeStyle) -> Glyph<(f64, f64)> {
+    Glyph {
+        at,
+        style,
+        marker: Some(i),
+        line: None,
+    }
+}
+
+/// A chart with nothing to draw: its frame, its title and why, wrapped to the width.
+fn placeholder(root: &Area, chart: &Chart, why: &str) -> Result<()> {
+    let title = text(TITLE_SIZE).pos(Pos::new(HPos::Center, VPos::Top));
+    root.draw_text(&chart.title, &title, ((WIDTH / 2) as i32, PAD as i32))
+        .map_err(drawing)?;
+    let top = 2 * PAD + 24;
+    let frame = [
+        (PAD as i32, top as i32),
+        ((WIDTH - PAD) as i32, (HEIGHT - PAD) as i32),
+    ];
+    root.draw(&Rectangle::new(frame, FRAME.stroke_width(1)))
+        .map_err(drawing)?;
+    let style = text(DESC_SIZE).pos(Pos::new(HPos::Center, VPos::Top));
+    let max_w = WIDTH - 2 * PAD - 60;
+    let mut lines = vec![String::from("nothing to draw:")];
+    for word in why.split_whitespace() {
+        let last = lines.last_mut().expect("one line at least");
+        let longer = format!("{last} {word}");
+        if !last.is_empty() && text_width(root, &longer, &style) > max_w {
+            lines.push(word.to_string());
+        } else {
+            *last = longer.trim_start().to_string();
+        }
+    }
+    let line_h = 24;
+    let y0 = (top + HEIGHT - PAD) as i32 / 2 - line_h * lines.len() as i32 / 2;
+    for (k, line) in lines.iter().enumerate() {
+        let at = ((WIDTH / 2) as i32, y0 + line_h * k as i32);
+        root.draw_text(line, &style, at).map_err(drawing)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@ use super::OptimizeResult;
 use super::objective::Evaluation;
 use crate::optics::dots::{Density, DensityGrid};
 use crate::output::atomic::SetDir;
+use crate::output::figure::thousands;
 use crate::output::map::{Grid, MapOptions, write_map};
 use crate::output::plot::{Chart, Scale, Series, write_chart};
 use anyhow::Result;
@@ -123,7 +124,10 @@ impl OptimizeResult {
         let opts = MapOptions {
             title: format!(
                 "Final dot density on {} ({}): area cv {:.3} at {} photons",
-                self.tag, self.method, e.area_cv, e.photons
+                self.tag,
+                self.method,
+                e.area_cv,
+                thousands(e.photons)
             ),
             x_label: along.into(),
             y_label: "position across the axis (mm)".into(),

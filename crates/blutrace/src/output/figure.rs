@@ -1,5 +1,5 @@
 //! What the PNG charts and maps share: the embedded font, the colour map, the palette,
-//! number labels, and rendering a `plotters` drawing into a PNG file.
+//! number labels, and drawing with `plotters` into an RGB buffer (which `png` encodes).
 //!
 //! Text is drawn with DejaVu Sans, embedded in the binary (the `dejavu` crate), so a
 //! machine without any system font draws the same pixels: nothing is looked up at run
@@ -92,6 +92,19 @@ pub(crate) fn format_label(v: f64) -> String {
     }
 }
 
+/// `n` with its digits in groups of three: `12,500,000`.
+pub fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// Pixel width of `s` in `style`.
 pub(crate) fn text_width(area: &Area, s: &str, style: &TextStyle) -> u32 {
     area.estimate_text_size(s, style).map_or(0, |(w, _)| w)
@@ -161,5 +174,9 @@ mod tests {
         assert_eq!(format_label(2.5e-7), "2.5e-7");
         assert_eq!(format_label(-1e6), "-1e6");
         assert_eq!(format_label(1.23456e-4), "1.23e-4");
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(12_500_000), "12,500,000");
     }
 }

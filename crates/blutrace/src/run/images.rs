@@ -33,6 +33,7 @@ use super::RunResult;
 use super::metrics::{self, Map};
 use crate::output::atomic::SetDir;
 use crate::output::exr::{Attribute, Samples, write_channels};
+use crate::output::figure::thousands;
 use crate::output::map::{Grid, MapOptions, write_map};
 use anyhow::Result;
 use glam::DVec3;
@@ -55,7 +56,7 @@ pub(super) fn write_flux_png(run: &RunResult, path: &Path, flux: &Map) -> Result
         title: format!(
             "{}: {} photons, extraction efficiency {:.2} %",
             run.scene.name,
-            l.photons,
+            thousands(l.photons),
             100.0 * efficiency
         ),
         x_label: "detector u (mm)".into(),

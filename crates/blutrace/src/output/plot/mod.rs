@@ -237,6 +237,30 @@ fn label_widths<C: Ranged<ValueType = f64>>(root: &Area, coord: &C, n: usize) ->
     )
 }
 
+/// Room for the text around the plot area, measured in the font (pixels): left of it
+/// (y tick labels and description), below it (x tick labels and description) and right of
+/// it (the legend, or half the last x tick label).
+fn label_room<X, Y>(root: &Area, chart: &Chart, x: &X, y: &Y) -> (u32, u32, u32)
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let (y_label_w, _) = label_widths(root, y, Y_TICKS);
+    let (_, last_x_w) = label_widths(root, x, X_TICKS);
+    let height = |s: &TextStyle| root.estimate_text_size("Ay", s).map_or(0, |(_, h)| h);
+    let desc = |label: &str| match label {
+        "" => 0,
+        _ => height(&text(DESC_SIZE)) + 6,
+    };
+    let y_area = 2 * TICK + y_label_w + 8 + desc(&chart.y_label);
+    let x_area = 2 * TICK + height(&text(LABEL_SIZE)) + 8 + desc(&chart.x_label);
+    let right = match legend::width(root, chart) {
+        0 => PAD.max(last_x_w / 2 + 6),
+        w => w + LEGEND_GAP + PAD,
+    };
+    (y_area, x_area, right)
+}
+
 /// Draw the chart on the axes `x` and `y` (linear or logarithmic ranges).
 fn draw_axes<X, Y>(root: &Area, chart: &Chart, x: X, y: Y) -> Result<PixelRect>
 where
@@ -246,35 +270,7 @@ where
     Y::CoordDescType: ValueFormatter<f64>,
 {
     let (xc, yc): (X::CoordDescType, Y::CoordDescType) = (x.clone().into(), y.clone().into());
-    let (y_label_w, _) = label_widths(root, &yc, Y_TICKS);
-    let (_, last_x_w) = label_widths(root, &xc, X_TICKS);
-    let desc_h = root
-        .estimate_text_size("Ay", &text(DESC_SIZE))
-        .map_or(0, |(_, h)| h);
-    let label_h = root
-        .estimate_text_size("0", &text(LABEL_SIZE))
-        .map_or(0, |(_, h)| h);
-    let y_area = 2 * TICK
-        + y_label_w
-        + 8
-        + if chart.y_label.is_empty() {
-            0
-        } else {
-            desc_h + 6
-        };
-    let x_area = 2 * TICK
-        + label_h
-        + 8
-        + if chart.x_label.is_empty() {
-            0
-        } else {
-            desc_h + 6
-        };
-    // Right of the plot: the legend, or room for the last x tick label.
-    let right = match legend::width(root, chart) {
-        0 => PAD.max(last_x_w / 2 + 6),
-        w => w + LEGEND_GAP + PAD,
-    };
+    let (y_area, x_area, right) = label_room(root, chart, &xc, &yc);
     let mut c = ChartBuilder::on(root)
         .caption(&chart.title, text(TITLE_SIZE))
         .margin(PAD)

@@ -160,9 +160,12 @@ mod tests {
         let e = parse("[s]\nmodel = \"lambert\"\nalbedo = 0.9\ncolour = 1\n").unwrap_err();
         assert!(e.contains("colour"), "{e}");
         let ctx = Ctx(Path::new("scene.toml"));
-        let media = [Medium::clear("air", 1.0, 0.0)];
+        let media = [
+            Medium::clear("air", 1.0, 0.0),
+            Medium::clear("pmma", 1.49, 0.0),
+        ];
         let glass =
-            parse("[s]\nmodel = \"dielectric\"\ninside = \"air\"\nback = \"absorber\"\n").unwrap();
+            parse("[s]\nmodel = \"dielectric\"\ninside = \"pmma\"\nback = \"absorber\"\n").unwrap();
         let e = glass
             .build(&ctx, "surfaces.s", &media)
             .unwrap_err()
@@ -172,7 +175,7 @@ mod tests {
             "{e}"
         );
         let see_through = parse(
-            "[s]\nmodel = \"lambert\"\nalbedo = 0.5\nback = { model = \"dielectric\", inside = \"air\" }\n",
+            "[s]\nmodel = \"lambert\"\nalbedo = 0.5\nback = { model = \"dielectric\", inside = \"pmma\" }\n",
         )
         .unwrap();
         let e = see_through

@@ -34,7 +34,6 @@ use crate::optics::medium::{Interface, MediumId};
 use crate::optics::model::Arrival;
 use crate::optics::spectrum::{Light, Spectral};
 use crate::optics::surface::{Feature, Outcome, SurfaceModel};
-use crate::optics::two_sided;
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Fate};
@@ -211,10 +210,9 @@ impl Tracer<'_> {
                     est: self.estimator,
                     light,
                 };
-                let t = tag as usize;
-                let back = self.scene.backs[t].as_ref();
-                two_sided::met(&self.scene.surfaces[t], back, dir, surf.normal)
-                    .interact_on(&at, rng)
+                // No back to choose: a solid's faces are interfaces, which have none
+                // (`optics::two_sided`).
+                self.scene.surfaces[tag as usize].interact_on(&at, rng)
             }
         }
     }

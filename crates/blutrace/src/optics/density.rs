@@ -521,9 +521,8 @@ impl Gradation {
     #[cfg(test)]
     /// Largest value over the span (sampled as [`Gradation::first_outside`] does).
     fn max_over_span(&self) -> f64 {
-        let samples = if self.is_constant() { 0 } else { 4096 };
-        (0..=samples)
-            .map(|i| self.at(self.length * i as f64 / samples.max(1) as f64))
+        self.span_values(4096)
+            .map(|(_, v)| v)
             .fold(f64::NEG_INFINITY, f64::max)
     }
 }

@@ -11,8 +11,8 @@
 //! A reflector sheet white on top and black below, a one-sided mirror film, a holder
 //! painted inside: a photon arriving against the triangle's normal (from the side it
 //! points to) meets the front model, one arriving along it the back model. The normal is
-//! the triangle's as wound in its geometry file, turned outwards where the face bounds a
-//! closed solid; `blutrace check` counts each tag's triangles by the axis their normal
+//! the triangle's as wound in its geometry file (an opaque face bounds no solid, so the
+//! solids' orientation leaves it alone); `blutrace check` counts each tag's triangles by the axis their normal
 //! points along, so which side is the front can be read off. Without `back` both sides
 //! carry the same model. A dielectric-like face (dielectric, dots, grooves, diffuser) has
 //! no back: its two sides are its two media.
@@ -50,12 +50,6 @@ impl<'de> Deserialize<'de> for SurfaceEntry {
             .transpose()?;
         let spec = SurfaceSpec::deserialize(toml::Value::Table(table)).map_err(D::Error::custom)?;
         Ok(SurfaceEntry { spec, back })
-    }
-}
-
-impl From<SurfaceSpec> for SurfaceEntry {
-    fn from(spec: SurfaceSpec) -> Self {
-        SurfaceEntry { spec, back: None }
     }
 }
 

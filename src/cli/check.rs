@@ -143,6 +143,9 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             s.name,
             s.power_w
         );
+        if let Some(sp) = &s.spectrum {
+            say!("           {:<20} {}", "", sp.describe());
+        }
     }
     let d = &scene.detector;
     say!(

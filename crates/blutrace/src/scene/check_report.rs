@@ -22,6 +22,7 @@ pub fn check_json(scene: &Scene, scene_file: &Path) -> Result<serde_json::Value>
             "power_w": s.power_w,
             "medium": scene.media[s.medium as usize].name,
             "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
+            "spectrum": s.spectrum.as_ref().map(|sp| sp.report()),
         })).collect::<Vec<_>>(),
         "surfaces": surfaces_json(scene),
         "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),

@@ -265,6 +265,33 @@ impl EmissionSpectrum {
     pub fn range_nm(&self) -> (f64, f64) {
         (self.nm[0], self.nm[self.nm.len() - 1])
     }
+
+    /// What `check` says of it: range, chromaticity, CCT and efficacy.
+    pub fn report(&self) -> serde_json::Value {
+        let xy = self.xyz_per_w.xy();
+        let cct = self.xyz_per_w.uv_prime().and_then(crate::color::cct);
+        serde_json::json!({
+            "range_nm": self.range_nm(),
+            "x": xy.map(|p| p.x),
+            "y": xy.map(|p| p.y),
+            "cct_k": cct.map(|c| c.kelvin),
+            "efficacy_lm_per_w": self.efficacy_lm_per_w(),
+        })
+    }
+
+    /// [`EmissionSpectrum::report`] in one line.
+    pub fn describe(&self) -> String {
+        let (lo, hi) = self.range_nm();
+        let xy = self.xyz_per_w.xy();
+        let cct = self.xyz_per_w.uv_prime().and_then(crate::color::cct);
+        format!(
+            "spectrum {lo}-{hi} nm, x {:.4} y {:.4}, CCT {}, {:.1} lm/W",
+            xy.map_or(f64::NAN, |p| p.x),
+            xy.map_or(f64::NAN, |p| p.y),
+            cct.map_or("-".into(), |c| format!("{:.0} K", c.kelvin)),
+            self.efficacy_lm_per_w()
+        )
+    }
 }
 
 /// The observer's x̄, ȳ, z̄ at `nm`, linear between the 1 nm rows, zero outside 360-830 nm

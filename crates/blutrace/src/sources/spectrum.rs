@@ -65,7 +65,10 @@ impl<'de> Deserialize<'de> for SpectrumSpec {
             return Ok(SpectrumSpec::Named(name.to_string()));
         }
         let Some(t) = v.as_table().filter(|t| t.len() == 1) else {
-            return Err(D::Error::custom(allowed));
+            return Err(D::Error::custom(format!(
+                "invalid type: {} {v}, {allowed}",
+                v.type_str()
+            )));
         };
         let (key, value) = t.iter().next().expect("one entry");
         let bad = |e: toml::de::Error| D::Error::custom(format!("{key}: {}", e.message()));

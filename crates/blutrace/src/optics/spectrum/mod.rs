@@ -257,7 +257,10 @@ impl<'de> Deserialize<'de> for SpectralValue {
             return Ok(SpectralValue::Constant(x));
         }
         let Some(t) = v.as_table().filter(|t| t.len() == 1) else {
-            return Err(D::Error::custom(allowed));
+            return Err(D::Error::custom(format!(
+                "invalid type: {} {v}, {allowed}",
+                v.type_str()
+            )));
         };
         let (key, value) = t.iter().next().expect("one entry");
         let bad = |e: toml::de::Error| D::Error::custom(format!("{key}: {}", e.message()));

@@ -1,12 +1,17 @@
 //! Time one reference kernel alone, single-threaded, for A/B rounds under `/usr/bin/time`:
 //!
 //! ```text
-//! cargo run --release -p blutrace-bench --example reference_speed -- new|before PHOTONS [SEED]
+//! cargo run --release -p blutrace-bench --example reference_speed -- new|before|blutrace|diff PHOTONS [SEED]
 //! ```
 //!
-//! Prints the fates and a checksum of the flux bins, so two builds can be compared for
-//! identical results as well as for speed.
+//! `new` is the reference kernel, `before` the kernel before issue 35, `blutrace` a
+//! single-threaded `run::trace` of the same scene and photons (auto backend, convex path,
+//! as `blutrace bench`), so all three can be timed the same way; `diff` finds the first
+//! photon whose counts differ between the two kernels. Prints the fates and a checksum of
+//! the flux bins, so two builds can be compared for identical results as well as for
+//! speed.
 
+use blutrace::run::{self, RunOptions};
 use blutrace::scene::Scene;
 use blutrace_bench::{reference, reference_before};
 use std::path::Path;
@@ -25,6 +30,20 @@ fn main() -> anyhow::Result<()> {
     if which == "dbg" {
         reference_before::Reference::new(&scene)?.trace(1, 3000);
         reference::Reference::new(&scene)?.trace(1, 3000);
+        return Ok(());
+    }
+    if which == "blutrace" {
+        let o = RunOptions {
+            photons,
+            seed,
+            threads: Some(1),
+            ..RunOptions::default()
+        };
+        let r = run::trace(&scene, &o, &|_| {})?;
+        println!(
+            "blutrace: detected {:.4}",
+            r.tally.ledger.detected.sum.value()
+        );
         return Ok(());
     }
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;

@@ -43,17 +43,18 @@ pub(super) fn bench(
 ) -> Result<()> {
     let rows = blutrace_bench::reference_table(box_scene, photons, threads, repeat)?;
     say!(
-        "| {}, {photons} photons | photons/s | interactions/s | ratio to the reference |",
+        "| {}, {photons} photons | photons/s | interactions/s | ratio to the reference | ratio to the old reference |",
         box_scene.display()
     );
-    say!("|---|---:|---:|---:|");
+    say!("|---|---:|---:|---:|---:|");
     for r in rows {
         say!(
-            "| {} | {:.0} | {:.0} | {:.3} |",
+            "| {} | {:.0} | {:.0} | {:.3} | {:.3} |",
             r.tracer,
             r.photons_per_s,
             r.interactions_per_s,
-            r.ratio_to_reference
+            r.ratio_to_reference,
+            r.ratio_to_old_reference
         );
     }
     say!();

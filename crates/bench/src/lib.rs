@@ -9,7 +9,9 @@
 //! (auto backend, convex path) against a hand-written kernel of the same physics
 //! ([`reference`](mod@reference), built from the same loaded scene), the same photons on the same
 //! threads, timed in interleaved rounds; the ratio says how far blutrace's general path
-//! is from what the physics costs.
+//! is from what the physics costs. The kernel as it was before issue 35 made it faster
+//! ([`reference_before`]) is timed in the same rounds, so the ratio to it stays
+//! comparable with the older measurements.
 //!
 //! Scenes: `scenes/notebook14` as bundled, and the same scene with its lamp reflectors
 //! split into about 540k triangles (same surfaces, so the same physics). Every timing is
@@ -28,6 +30,7 @@ pub mod box_scene;
 pub mod cavity;
 pub mod load;
 pub mod reference;
+pub mod reference_before;
 
 pub use cavity::large_mesh_table;
 pub use load::large_load_row;
@@ -66,7 +69,8 @@ pub struct BenchRow {
 /// One row of the speed-of-light table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SpeedRow {
-    /// What traced: blutrace (its backend) or the reference kernel.
+    /// What traced: blutrace (its backend), the reference kernel or the reference kernel
+    /// as it was before issue 35.
     pub tracer: String,
     /// Photons per second.
     pub photons_per_s: f64,
@@ -74,13 +78,15 @@ pub struct SpeedRow {
     pub interactions_per_s: f64,
     /// photons_per_s over the reference kernel's.
     pub ratio_to_reference: f64,
+    /// photons_per_s over the old reference kernel's ([`reference_before`]).
+    pub ratio_to_old_reference: f64,
 }
 
-/// blutrace (auto backend, convex path on) and the reference kernel ([`reference`](mod@reference)) on
-/// the box-guide scene in `box_dir`: the same photons of seed 1 on the same `threads`,
-/// `repeat` rounds each timing both in turn (medians). blutrace's rate is its run's
-/// (tracing and per-round metrics, without loading); the reference's, its tracing. Rows:
-/// blutrace, then the reference.
+/// blutrace (auto backend, convex path on), the reference kernel ([`reference`](mod@reference))
+/// and the old one ([`reference_before`]) on the box-guide scene in `box_dir`: the same
+/// photons of seed 1 on the same `threads`, `repeat` rounds each timing all three in turn
+/// (medians). blutrace's rate is its run's (tracing and per-round metrics, without
+/// loading); the kernels', their tracing. Rows: blutrace, the reference, the old reference.
 pub fn reference_table(
     box_dir: &Path,
     photons: u64,
@@ -89,6 +95,7 @@ pub fn reference_table(
 ) -> Result<Vec<SpeedRow>> {
     let scene = Scene::load(&box_dir.join("scene.toml"))?;
     let kernel = reference::Reference::new(&scene)?;
+    let old = reference_before::Reference::new(&scene)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()?;
@@ -100,17 +107,21 @@ pub fn reference_table(
         convex: true,
         ..RunOptions::default()
     };
-    let (mut blutrace, mut hand) = (Vec::new(), Vec::new());
+    let timed = |trace: &(dyn Fn() -> reference::Counts + Sync)| {
+        let start = Instant::now();
+        let c = pool.install(trace);
+        let t = start.elapsed().as_secs_f64();
+        (c.photons as f64 / t, c.interactions as f64 / t)
+    };
+    let (mut blutrace, mut hand, mut before) = (Vec::new(), Vec::new(), Vec::new());
     let mut backend = "";
     for _ in 0..repeat.max(1) {
         let r = run::trace(&scene, &o, &|_| {})?;
         let s = r.summary();
         blutrace.push((s.photons_per_s, s.interactions_per_s));
         backend = r.backend;
-        let start = Instant::now();
-        let c = pool.install(|| kernel.trace(1, photons));
-        let t = start.elapsed().as_secs_f64();
-        hand.push((c.photons as f64 / t, c.interactions as f64 / t));
+        hand.push(timed(&|| kernel.trace(1, photons)));
+        before.push(timed(&|| old.trace(1, photons)));
     }
     let med = |v: &[(f64, f64)]| {
         (
@@ -118,20 +129,18 @@ pub fn reference_table(
             median(v.iter().map(|r| r.1).collect()),
         )
     };
-    let (b, h) = (med(&blutrace), med(&hand));
+    let (h, b) = (med(&hand), med(&before));
+    let row = |tracer: String, (photons_per_s, interactions_per_s): (f64, f64)| SpeedRow {
+        tracer,
+        photons_per_s,
+        interactions_per_s,
+        ratio_to_reference: photons_per_s / h.0,
+        ratio_to_old_reference: photons_per_s / b.0,
+    };
     Ok(vec![
-        SpeedRow {
-            tracer: format!("blutrace ({backend}, convex path)"),
-            photons_per_s: b.0,
-            interactions_per_s: b.1,
-            ratio_to_reference: b.0 / h.0,
-        },
-        SpeedRow {
-            tracer: "reference kernel (f32, analytic planes)".into(),
-            photons_per_s: h.0,
-            interactions_per_s: h.1,
-            ratio_to_reference: 1.0,
-        },
+        row(format!("blutrace ({backend}, convex path)"), med(&blutrace)),
+        row("reference kernel (f32, analytic planes)".into(), h),
+        row("reference kernel before issue 35".into(), b),
     ])
 }
 
@@ -368,17 +377,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn speed_of_light_table_has_blutrace_then_the_reference() {
+    fn speed_of_light_table_has_blutrace_then_both_references() {
         let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes/bench-box");
         let rows = reference_table(&dir, 4096, Some(1), 2).unwrap();
-        assert_eq!(rows.len(), 2);
+        assert_eq!(rows.len(), 3);
         assert!(rows[0].tracer.starts_with("blutrace ("));
-        assert!(rows[1].tracer.starts_with("reference kernel"));
+        assert!(rows[1].tracer.starts_with("reference kernel ("));
+        assert!(rows[2].tracer.starts_with("reference kernel before"));
         assert_eq!(rows[1].ratio_to_reference, 1.0);
-        assert_eq!(
-            rows[0].ratio_to_reference,
-            rows[0].photons_per_s / rows[1].photons_per_s
-        );
+        assert_eq!(rows[2].ratio_to_old_reference, 1.0);
+        for r in &rows {
+            assert_eq!(
+                r.ratio_to_reference,
+                r.photons_per_s / rows[1].photons_per_s
+            );
+            assert_eq!(
+                r.ratio_to_old_reference,
+                r.photons_per_s / rows[2].photons_per_s
+            );
+        }
         for r in &rows {
             assert!(r.photons_per_s > 0.0 && r.interactions_per_s > r.photons_per_s);
         }

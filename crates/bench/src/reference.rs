@@ -29,6 +29,32 @@
 //! at an axis-aligned face scales the tangential components by `n1/n2` and sets the
 //! normal one to `cos t`.
 //!
+//! How it is fast (issue 35; single-threaded user CPU seconds on bench-box, interleaved
+//! A/B rounds of 2-4 million photons, medians; the kernel before it is kept as
+//! [`super::reference_before`]). Most of a photon's 13.5 interactions are total internal
+//! reflections inside the guide (12.3 guide steps, 2.1 air steps, 5.6 dotted-face hits
+//! of which 1.2 land in a dot, per photon), so the guide step is the kernel:
+//! - its nearest face is chosen by branches into per-axis code (`face::<K>`), not by
+//!   selects or a runtime axis index: the branches are predicted (most steps cross the
+//!   thickness), so the position's dependency chain does not wait for the comparisons,
+//!   and positions and directions are arrays indexed by constants, in registers (glam's
+//!   `Vec3` indexed by a runtime axis is a match per access): 1.23x;
+//! - the direction's reciprocal is kept with it (a reflection negates one lane), so a step
+//!   costs no division: 1.06x;
+//! - the dot lookup works in cell units from the cell's centre and finds the cell by
+//!   rounding in float arithmetic (no float-integer conversions): its answer is a branch
+//!   mispredicted at every dot hit, which waits for the lookup: 1.05x for the cell units,
+//!   1.10x more for the rounding;
+//! - photons are counted per chunk in a small tally (fate counters in an array), and
+//!   the run of guide steps is a loop of its own: about 1.06x together.
+//!
+//! Measured and not kept, because they bought nothing measurable: Fresnel's roulette
+//! without its two divisions; one reciprocal for all the planes of an air step; walking
+//! the guide as three independent billiards (the hits along each axis are periodic
+//! between changes of direction, positions computed only at the dotted face). Not
+//! costs: the per-photon generator start (a generator per chunk instead: within 2 %),
+//! `ln` per photon (0.3 % of the profile), the chunk loop and its counting (2 %).
+//!
 //! Why `f32` is safe here: positions in the recentred scene (within 70 mm of the origin
 //! for bench-box) round to 4 nm; every hit puts the photon exactly on its plane, so
 //! rounding only random-walks the in-plane coordinates, about 0.1 um after a thousand
@@ -42,7 +68,7 @@
 //! from a SplitMix64 hash of `(s, i)`, so results depend on seed and index only, never on
 //! threads.
 
-use super::box_scene::{AaRect, Body, BoxScene};
+use super::box_scene::{AaRect, Body, BoxScene, Dots};
 use anyhow::Result;
 use blutrace::scene::Scene;
 use glam::Vec3;
@@ -85,14 +111,14 @@ pub struct Counts {
 }
 
 impl Counts {
-    fn new(bins: usize) -> Self {
+    pub(crate) fn new(bins: usize) -> Self {
         Self {
             flux: vec![0; bins],
             ..Default::default()
         }
     }
 
-    fn merge(mut self, o: Counts) -> Counts {
+    pub(crate) fn merge(mut self, o: Counts) -> Counts {
         self.photons += o.photons;
         self.detected += o.detected;
         self.detected_near_normal += o.detected_near_normal;
@@ -120,7 +146,9 @@ impl Counts {
     }
 }
 
-/// How one photon ended.
+/// How one photon ended: the index of its counter in [`Tally::fates`], and the flux bin
+/// and near-normal flag of a detection.
+#[derive(Clone, Copy)]
 enum Fate {
     /// In this flux bin, within 30 degrees of the normal or not.
     Detected(usize, bool),
@@ -140,18 +168,121 @@ enum Struck {
     Body,
 }
 
+/// One side of the guide's dielectric faces, from index `n1` into `n2`, with the
+/// constants of its Fresnel roulette.
+#[derive(Clone, Copy, Debug)]
+struct Interface {
+    n1: f32,
+    n2: f32,
+    /// `n1 / n2`.
+    eta: f32,
+    /// `(1 - eta) (1 + eta)`: `cos^2 t = this + eta^2 cos^2 i`.
+    one_minus_eta2: f32,
+    /// `eta^2`.
+    eta2: f32,
+}
+
+impl Interface {
+    fn new(n1: f32, n2: f32) -> Self {
+        let eta = n1 / n2;
+        Interface {
+            n1,
+            n2,
+            eta,
+            one_minus_eta2: (1.0 - eta) * (1.0 + eta),
+            eta2: eta * eta,
+        }
+    }
+
+    /// Fresnel roulette at incidence cosine `cos_i`: `None` when reflected (always under
+    /// total internal reflection, without a draw), else `cos t` of the refracted
+    /// direction.
+    #[inline(always)]
+    fn refract(&self, cos_i: f32, rng: &mut Rng) -> Option<f32> {
+        let cos2_t = self.one_minus_eta2 + self.eta2 * cos_i * cos_i;
+        if cos2_t <= 0.0 {
+            return None;
+        }
+        let cos_t = cos2_t.sqrt();
+        let rs = (self.n1 * cos_i - self.n2 * cos_t) / (self.n1 * cos_i + self.n2 * cos_t);
+        let rp = (self.n2 * cos_i - self.n1 * cos_t) / (self.n2 * cos_i + self.n1 * cos_t);
+        (rng.uniform() >= 0.5 * (rs * rs + rp * rp)).then_some(cos_t)
+    }
+}
+
+/// A photon's run inside the guide: where it left (position, direction), its fate if it
+/// ended there, its interactions so far.
+type Leg = (Vec3, Vec3, Option<Fate>, u32);
+
+/// A photon inside the guide: position, direction, its reciprocal (updated with it, so a
+/// step costs no division), interactions so far. Plain arrays indexed by constants: they
+/// stay in registers.
+struct Guided {
+    p: [f32; 3],
+    d: [f32; 3],
+    inv: [f32; 3],
+    n: u32,
+}
+
+/// The dot lattice in cell units: `(p - origin) . axis` is the position along the
+/// pattern in cells from a cell's centre (the pattern's origin moved half a cell on both
+/// axes).
+struct Cells {
+    origin: Vec3,
+    axis: Vec3,
+    across: Vec3,
+    col0: i32,
+    /// Squared dot radius per column, in cells squared.
+    r2: Vec<f32>,
+}
+
+impl Cells {
+    fn new(dots: &Dots) -> Self {
+        let per_cell = 1.0 / dots.pitch;
+        Cells {
+            origin: dots.origin + 0.5 * dots.pitch * (dots.axis + dots.across),
+            axis: dots.axis * per_cell,
+            across: dots.across * per_cell,
+            col0: dots.col0,
+            r2: dots.r2.iter().map(|r2| r2 * per_cell * per_cell).collect(),
+        }
+    }
+}
+
+/// Per-chunk counters, in registers and a few cache lines while a chunk is traced.
+struct Tally {
+    /// Photons per fate, in [`Fate`]'s order (detected first).
+    fates: [u64; 7],
+    near_normal: u64,
+    interactions: u64,
+    interactions_sq: u128,
+}
+
 /// The reference kernel of one box-guide scene.
 pub struct Reference {
     s: BoxScene,
-    inv_pitch: f32,
+    /// Air into the guide, and the guide into air.
+    enter: Interface,
+    leave: Interface,
+    /// The dots in cell units.
+    cells: Cells,
+    /// Flux bins per mm along the target's u and v, signed as its axes.
+    bins_per_mm: [f32; 2],
 }
 
 impl Reference {
     /// The kernel for `scene`, or an error saying why it is not a box-guide scene.
     pub fn new(scene: &Scene) -> Result<Reference> {
         let s = BoxScene::from_scene(scene)?;
+        let g = &s.target;
         Ok(Reference {
-            inv_pitch: 1.0 / s.dots.pitch,
+            enter: Interface::new(s.n_air, s.n_guide),
+            leave: Interface::new(s.n_guide, s.n_air),
+            cells: Cells::new(&s.dots),
+            bins_per_mm: [
+                g.u.1 * g.bins[0] as f32 / g.size[0],
+                g.v.1 * g.bins[1] as f32 / g.size[1],
+            ],
             s,
         })
     }
@@ -165,77 +296,73 @@ impl Reference {
     /// fixed chunks; the counts do not depend on the thread count.
     pub fn trace(&self, seed: u64, photons: u64) -> Counts {
         let bins = self.s.target.bins[0] * self.s.target.bins[1];
+        let key = splitmix64(seed);
         (0..photons.div_ceil(CHUNK))
             .into_par_iter()
             .fold(
                 || Counts::new(bins),
                 |mut c, k| {
-                    for i in k * CHUNK..((k + 1) * CHUNK).min(photons) {
-                        self.trace_photon(seed, i, &mut c);
-                    }
+                    self.trace_chunk(key, k * CHUNK..((k + 1) * CHUNK).min(photons), &mut c);
                     c
                 },
             )
             .reduce(|| Counts::new(bins), Counts::merge)
     }
 
-    fn trace_photon(&self, seed: u64, index: u64, c: &mut Counts) {
-        let mut rng = Rng::new(seed, index);
-        let (fate, n) = self.follow(&mut rng);
-        c.photons += 1;
-        c.interactions += u64::from(n);
-        c.interactions_sq += u128::from(n) * u128::from(n);
-        match fate {
-            Fate::Detected(bin, near_normal) => {
-                c.detected += 1;
-                c.detected_near_normal += u64::from(near_normal);
-                c.flux[bin] += 1;
-            }
-            Fate::Ink => c.absorbed_by_ink += 1,
-            Fate::Sheet => c.absorbed_by_sheet += 1,
-            Fate::Medium => c.absorbed_in_medium += 1,
-            Fate::Source => c.absorbed_by_source += 1,
-            Fate::Escaped => c.escaped += 1,
-            Fate::Killed => c.killed += 1,
+    fn trace_chunk(&self, key: u64, photons: std::ops::Range<u64>, c: &mut Counts) {
+        let mut t = Tally {
+            fates: [0; 7],
+            near_normal: 0,
+            interactions: 0,
+            interactions_sq: 0,
+        };
+        for i in photons {
+            let mut rng = Rng::new(key, i);
+            let (fate, n) = self.follow(&mut rng);
+            t.interactions += u64::from(n);
+            t.interactions_sq += u128::from(n) * u128::from(n);
+            let slot = match fate {
+                Fate::Detected(bin, near) => {
+                    c.flux[bin] += 1;
+                    t.near_normal += u64::from(near);
+                    0
+                }
+                Fate::Ink => 1,
+                Fate::Sheet => 2,
+                Fate::Medium => 3,
+                Fate::Source => 4,
+                Fate::Escaped => 5,
+                Fate::Killed => 6,
+            };
+            t.fates[slot] += 1;
         }
+        let f = t.fates;
+        c.photons += f.iter().sum::<u64>();
+        c.detected += f[0];
+        c.absorbed_by_ink += f[1];
+        c.absorbed_by_sheet += f[2];
+        c.absorbed_in_medium += f[3];
+        c.absorbed_by_source += f[4];
+        c.escaped += f[5];
+        c.killed += f[6];
+        c.detected_near_normal += t.near_normal;
+        c.interactions += t.interactions;
+        c.interactions_sq += t.interactions_sq;
     }
 
-    /// One photon from emission to its fate; also its number of interactions.
+    /// One photon from emission to its fate; also its number of interactions `n`.
     ///
-    /// One function on purpose: split into steps over a photon struct (the same
-    /// arithmetic, the same counts) it ran 20 % slower, and this is the speed of light.
+    /// The photon alternates between air steps (this loop) and a run of steps inside the
+    /// guide ([`Reference::in_guide`]), which is where most interactions happen.
     fn follow(&self, rng: &mut Rng) -> (Fate, u32) {
         let s = &self.s;
         let strip = &s.strip;
         let mut p = point_on(&strip.rect, rng);
-        let mut d = lambertian(strip.rect.axis, strip.facing, rng);
+        let mut d = Vec3::from_array(lambertian(strip.rect.axis, strip.facing, rng));
         // Optical depth left before the guide's bulk absorbs the photon.
         let mut depth = -(1.0 - rng.uniform()).ln();
-        let mut inside = false;
-        for n in 0..s.max_bounces {
-            if inside {
-                let (t, face) = self.exit(p, d);
-                let tau = s.absorption * t;
-                if tau > depth {
-                    return (Fate::Medium, n);
-                }
-                depth -= tau;
-                p = self.on_face(p + d * t, face);
-                let (k, out) = (face / 2, side(face));
-                if face == s.dots.face && self.ink(p) {
-                    if rng.uniform() >= s.dots.ink_albedo {
-                        return (Fate::Ink, n + 1);
-                    }
-                    d = lambertian(k, -out, rng);
-                } else if let Some((eta, cos_t)) = fresnel(d[k].abs(), s.n_guide, s.n_air, rng) {
-                    d *= eta;
-                    d[k] = out * cos_t;
-                    inside = false;
-                } else {
-                    d[k] = -d[k];
-                }
-                continue;
-            }
+        let mut n = 0;
+        while n < s.max_bounces {
             let (t, struck) = self.nearest_in_air(p, d);
             if let Some(bin) = self.detected(p, d, t) {
                 let g = &s.target;
@@ -246,66 +373,136 @@ impl Reference {
                 return (Fate::Escaped, n);
             };
             let from = p;
+            p += d * t;
             match struck {
                 Struck::Guide(face) => {
-                    p = self.on_face(p + d * t, face);
-                    let (k, out) = (face / 2, side(face));
-                    if face == s.dots.face && self.ink(p) {
+                    let k = face / 2;
+                    p[k] = if face % 2 == 1 { s.hi[k] } else { s.lo[k] };
+                    let out = side(face);
+                    if face == s.dots.face && self.ink(p.to_array()) {
                         if rng.uniform() >= s.dots.ink_albedo {
                             return (Fate::Ink, n + 1);
                         }
-                        d = lambertian(k, out, rng);
-                    } else if let Some((eta, cos_t)) = fresnel(d[k].abs(), s.n_air, s.n_guide, rng)
-                    {
-                        d *= eta;
+                        d = Vec3::from_array(lambertian(k, out, rng));
+                    } else if let Some(cos_t) = self.enter.refract(d[k].abs(), rng) {
+                        d *= self.enter.eta;
                         d[k] = -out * cos_t;
-                        inside = true;
+                        let (q, e, fate, m) = self.in_guide(p, d, &mut depth, n + 1, rng);
+                        if let Some(fate) = fate {
+                            return (fate, m);
+                        }
+                        (p, d, n) = (q, e, m);
+                        continue;
                     } else {
                         d[k] = -d[k];
                     }
                 }
                 Struck::Sheet => {
                     let k = s.sheet.axis;
-                    p = on_plane(p + d * t, &s.sheet);
+                    p[k] = s.sheet.at;
                     if rng.uniform() >= s.sheet_albedo {
                         return (Fate::Sheet, n + 1);
                     }
-                    d = lambertian(k, -d[k].signum(), rng);
+                    d = Vec3::from_array(lambertian(k, -d[k].signum(), rng));
                 }
                 Struck::Body => {
                     let r = &strip.rect;
-                    p = on_plane(p + d * t, r);
+                    p[r.axis] = r.at;
                     let front = (from[r.axis] - r.at) * strip.facing > 0.0;
                     match strip.body {
                         Body::Lambert(albedo) if front && rng.uniform() < albedo => {
-                            d = lambertian(r.axis, strip.facing, rng);
+                            d = Vec3::from_array(lambertian(r.axis, strip.facing, rng));
                         }
                         _ => return (Fate::Source, n + 1),
                     }
                 }
             }
+            n += 1;
         }
         (Fate::Killed, s.max_bounces)
     }
 
-    /// Where a photon inside the guide leaves it: distance and face (`2 axis + side`).
-    #[inline]
-    fn exit(&self, p: Vec3, d: Vec3) -> (f32, usize) {
-        let (mut best, mut face) = (f32::INFINITY, 0);
-        for k in 0..3 {
-            let (bound, f) = if d[k] > 0.0 {
-                (self.s.hi[k], 2 * k + 1)
-            } else if d[k] < 0.0 {
-                (self.s.lo[k], 2 * k)
+    /// Steps of a photon inside the guide, from `n` interactions, until it leaves (its
+    /// position, direction and interactions, no fate) or ends (its fate).
+    #[inline(always)]
+    fn in_guide(&self, p: Vec3, d: Vec3, depth: &mut f32, n: u32, rng: &mut Rng) -> Leg {
+        let mut g = Guided {
+            p: p.to_array(),
+            d: d.to_array(),
+            inv: d.recip().to_array(),
+            n,
+        };
+        let (lo, hi) = (self.s.lo.to_array(), self.s.hi.to_array());
+        while g.n < self.s.max_bounces {
+            let t: [f32; 3] = std::array::from_fn(|k| {
+                let bound = if g.d[k] > 0.0 { hi[k] } else { lo[k] };
+                // An axis along which the photon does not move never bounds the step.
+                if g.d[k] == 0.0 {
+                    f32::INFINITY
+                } else {
+                    ((bound - g.p[k]) * g.inv[k]).max(0.0)
+                }
+            });
+            // The nearest face (the lowest axis on ties), tested by branches, not
+            // selects: they are predicted (most steps cross the thickness), so the
+            // position's dependency chain does not wait for the comparisons.
+            let end = if t[2] < t[0] && t[2] < t[1] {
+                self.face::<2>(&mut g, t[2], depth, rng)
+            } else if t[0] <= t[1] {
+                self.face::<0>(&mut g, t[0], depth, rng)
             } else {
-                continue;
+                self.face::<1>(&mut g, t[1], depth, rng)
             };
-            let t = ((bound - p[k]) / d[k]).max(0.0);
-            if t < best {
-                (best, face) = (t, f);
+            if let Some(end) = end {
+                return (Vec3::from_array(g.p), Vec3::from_array(g.d), end, g.n);
             }
         }
-        (best, face)
+        let (p, d) = (Vec3::from_array(g.p), Vec3::from_array(g.d));
+        (p, d, Some(Fate::Killed), self.s.max_bounces)
+    }
+
+    /// A photon inside the guide moves `step` to its face along axis `K` and meets it:
+    /// `None` when it stays inside, `Some(None)` when it refracts out, `Some(fate)` when
+    /// it ends.
+    #[inline(always)]
+    fn face<const K: usize>(
+        &self,
+        g: &mut Guided,
+        step: f32,
+        depth: &mut f32,
+        rng: &mut Rng,
+    ) -> Option<Option<Fate>> {
+        let s = &self.s;
+        let tau = s.absorption * step;
+        if tau > *depth {
+            return Some(Some(Fate::Medium));
+        }
+        *depth -= tau;
+        let up = g.d[K] > 0.0;
+        for j in 0..3 {
+            g.p[j] = if j == K {
+                if up { s.hi[K] } else { s.lo[K] }
+            } else {
+                g.p[j] + g.d[j] * step
+            };
+        }
+        g.n += 1;
+        let out = if up { 1.0 } else { -1.0 };
+        if 2 * K + usize::from(up) == s.dots.face && self.ink(g.p) {
+            if rng.uniform() >= s.dots.ink_albedo {
+                return Some(Some(Fate::Ink));
+            }
+            g.d = lambertian(K, -out, rng);
+            g.inv = g.d.map(|x| 1.0 / x);
+        } else if let Some(cos_t) = self.leave.refract(g.d[K].abs(), rng) {
+            g.d = g.d.map(|x| x * self.leave.eta);
+            g.d[K] = out * cos_t;
+            return Some(None);
+        } else {
+            g.d[K] = -g.d[K];
+            g.inv[K] = -g.inv[K];
+        }
+        None
     }
 
     /// Where a photon in air enters the guide (slabs): distance and face.
@@ -364,59 +561,41 @@ impl Reference {
         }
         let t = g.rect.hit(p, d).filter(|&t| t < t_surface)?;
         let q = p + d * t - g.origin;
-        let bin = |(k, sign): (usize, f32), size: f32, n: usize| {
-            ((sign * q[k] / size * n as f32) as usize).min(n - 1)
-        };
-        Some(bin(g.v, g.size[1], g.bins[1]) * g.bins[0] + bin(g.u, g.size[0], g.bins[0]))
+        let bin = |k: usize, per_mm: f32, n: usize| ((q[k] * per_mm) as usize).min(n - 1);
+        let [nu, nv] = g.bins;
+        Some(bin(g.v.0, self.bins_per_mm[1], nv) * nu + bin(g.u.0, self.bins_per_mm[0], nu))
     }
 
     /// True when `p` on the dotted face lies inside a dot.
+    ///
+    /// In cell units, from the cell's centre: `w`, the position along the pattern less
+    /// half a cell, is `dx` off its nearest integer (the column, as `floor(w + 1/2)`), by
+    /// the float-rounding trick (adding `1.5 * 2^23` rounds to an integer, whose bits
+    /// are the column): no float-integer conversions, and no multiplication by the pitch,
+    /// between the position and the branch on the answer, which is mispredicted whenever
+    /// a dot is hit (and so waits for it). A point exactly on a cell edge (a tie) may
+    /// take either cell.
     #[inline(always)]
-    fn ink(&self, p: Vec3) -> bool {
-        let dots = &self.s.dots;
-        let r = p - dots.origin;
-        let (qa, qc) = (r.dot(dots.axis), r.dot(dots.across));
-        let (i, j) = (floor(qa * self.inv_pitch), floor(qc * self.inv_pitch));
-        let col = (i - dots.col0).clamp(0, dots.r2.len() as i32 - 1) as usize;
-        let (dx, dy) = (
-            qa - (i as f32 + 0.5) * dots.pitch,
-            qc - (j as f32 + 0.5) * dots.pitch,
-        );
-        dx * dx + dy * dy < dots.r2[col]
-    }
-
-    /// `p` put exactly on the plane of the guide's face `face`.
-    #[inline]
-    fn on_face(&self, mut p: Vec3, face: usize) -> Vec3 {
-        let k = face / 2;
-        p[k] = if face % 2 == 1 {
-            self.s.hi[k]
-        } else {
-            self.s.lo[k]
-        };
-        p
+    fn ink(&self, p: [f32; 3]) -> bool {
+        let c = &self.cells;
+        let r = Vec3::from_array(p) - c.origin;
+        let (w, z) = (r.dot(c.axis), r.dot(c.across));
+        let (rw, rz) = ((w + ROUND) - ROUND, (z + ROUND) - ROUND);
+        let column = (w + ROUND).to_bits() as i32 - ROUND.to_bits() as i32;
+        let col = (column - c.col0).clamp(0, c.r2.len() as i32 - 1) as usize;
+        let (dx, dy) = (w - rw, z - rz);
+        dx * dx + dy * dy < c.r2[col]
     }
 }
+
+/// `1.5 * 2^23`: added to an `f32` of magnitude below `2^22`, rounds it to an integer
+/// held in the low mantissa bits.
+const ROUND: f32 = 12_582_912.0;
 
 /// The outward normal's sign along its axis of the guide's face `face`.
 #[inline]
 fn side(face: usize) -> f32 {
     if face % 2 == 1 { 1.0 } else { -1.0 }
-}
-
-/// The largest integer not above `x` (within the face's few thousand cells): without
-/// the libm call `f32::floor` makes on baseline x86-64.
-#[inline]
-fn floor(x: f32) -> i32 {
-    let i = x as i32;
-    i - i32::from(x < i as f32)
-}
-
-/// `p` put exactly on the plane of `r`.
-#[inline]
-fn on_plane(mut p: Vec3, r: &AaRect) -> Vec3 {
-    p[r.axis] = r.at;
-    p
 }
 
 /// A uniform point of `r`.
@@ -431,42 +610,27 @@ fn point_on(r: &AaRect, rng: &mut Rng) -> Vec3 {
 
 /// A Lambertian direction about the axis `k` with sign `sign` (Malley's method).
 #[inline]
-fn lambertian(k: usize, sign: f32, rng: &mut Rng) -> Vec3 {
+fn lambertian(k: usize, sign: f32, rng: &mut Rng) -> [f32; 3] {
     let (k1, k2) = AaRect::others(k);
     loop {
         let (a, b) = (2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
         let r2 = a * a + b * b;
         if r2 < 1.0 {
-            let mut d = Vec3::ZERO;
+            let mut d = [0.0; 3];
             (d[k], d[k1], d[k2]) = (sign * (1.0 - r2).sqrt(), a, b);
             return d;
         }
     }
 }
 
-/// Fresnel roulette from index `n1` into `n2` at incidence cosine `cos_i`: `None` when
-/// reflected (always under total internal reflection), else `(n1/n2, cos t)` of the
-/// refracted direction.
-#[inline]
-fn fresnel(cos_i: f32, n1: f32, n2: f32, rng: &mut Rng) -> Option<(f32, f32)> {
-    let eta = n1 / n2;
-    let cos2_t = (1.0 - eta) * (1.0 + eta) + eta * eta * cos_i * cos_i;
-    if cos2_t <= 0.0 {
-        return None;
-    }
-    let cos_t = cos2_t.sqrt();
-    let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
-    let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
-    let r = 0.5 * (rs * rs + rp * rp);
-    (rng.uniform() >= r).then_some((eta, cos_t))
-}
-
 /// xoshiro128++ with a per-photon start.
 struct Rng([u32; 4]);
 
 impl Rng {
-    fn new(seed: u64, index: u64) -> Self {
-        let a = splitmix64(splitmix64(seed) ^ index);
+    /// Photon `index`'s generator under `key`, SplitMix64 of the seed.
+    #[inline]
+    fn new(key: u64, index: u64) -> Self {
+        let a = splitmix64(key ^ index);
         let b = splitmix64(a ^ 0xD1B5_4A32_D192_ED03);
         let s = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32];
         Rng(if s == [0; 4] { [1, 0, 0, 0] } else { s })
@@ -575,13 +739,13 @@ mod tests {
         let mut rng = Rng::new(1, 2);
         let n = 200_000;
         let reflected = (0..n)
-            .filter(|_| fresnel(1.0, 1.0, 1.49, &mut rng).is_none())
+            .filter(|_| Interface::new(1.0, 1.49).refract(1.0, &mut rng).is_none())
             .count();
         let r0 = (0.49f64 / 2.49).powi(2);
         let se = (r0 * (1.0 - r0) / n as f64).sqrt();
         assert!((reflected as f64 / n as f64 - r0).abs() < 4.0 * se);
         assert!(
-            fresnel(0.5, 1.49, 1.0, &mut rng).is_none(),
+            Interface::new(1.49, 1.0).refract(0.5, &mut rng).is_none(),
             "beyond critical"
         );
     }

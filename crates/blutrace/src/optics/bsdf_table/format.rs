@@ -171,7 +171,7 @@ impl<'a> Words<'a> {
     fn angles(&mut self, key: &str, (lo, hi, open): (f64, f64, bool)) -> Result<Vec<f64>> {
         let w = self.keyed(key)?;
         let n: usize = match w.text.parse() {
-            Ok(n) if n >= 1 && n <= 100_000 => n,
+            Ok(n) if (1..=100_000).contains(&n) => n,
             _ => {
                 return Err(self.err_at(
                     w.line,

@@ -264,31 +264,7 @@ impl SurfaceSpecOf for BsdfTableSpec {
         if files.is_empty() {
             return Err(ctx.err(&field, "names no file"));
         }
-        let (mut brdf, mut btdf): (Option<(PathBuf, Arc<Table>)>, Option<(PathBuf, Arc<Table>)>) =
-            (None, None);
-        for f in &files {
-            let path = dir.join(f);
-            let text = crate::input_file::read_text(&path, "BSDF table")
-                .map_err(|e| ctx.err(&field, format!("{e:#}")))?;
-            for sec in format::parse(&text, &path)? {
-                let slot = match sec.scatter {
-                    ScatterType::Brdf => &mut brdf,
-                    ScatterType::Btdf => &mut btdf,
-                };
-                if let Some((first, _)) = slot {
-                    return Err(ctx.err(
-                        &field,
-                        format!(
-                            "{} holds a second {} section (the first is in {}): give one of each at most",
-                            path.display(),
-                            sec.scatter.keyword(),
-                            first.display()
-                        ),
-                    ));
-                }
-                *slot = Some((path.clone(), Arc::new(Table::new(&sec, &path)?)));
-            }
-        }
+        let (brdf, btdf) = read_tables(ctx, &field, dir, &files)?;
         check_sum(ctx, &field, brdf.as_ref(), btdf.as_ref())?;
         let interface = match (&self.inside, &btdf) {
             (Some(inside), _) => Some(Interface::build(ctx, at, inside, &self.outside, media)?),
@@ -318,6 +294,38 @@ impl SurfaceSpecOf for BsdfTableSpec {
     fn files(&self) -> Vec<PathBuf> {
         self.file.list()
     }
+}
+
+/// A table and the file it came from.
+type Loaded = Option<(PathBuf, Arc<Table>)>;
+
+/// Read `files` (relative to `dir`; `field` names them in errors): the BRDF and the BTDF.
+fn read_tables(ctx: &Ctx, field: &str, dir: &Path, files: &[PathBuf]) -> Result<(Loaded, Loaded)> {
+    let (mut brdf, mut btdf): (Loaded, Loaded) = (None, None);
+    for f in files {
+        let path = dir.join(f);
+        let text = crate::input_file::read_text(&path, "BSDF table")
+            .map_err(|e| ctx.err(field, format!("{e:#}")))?;
+        for sec in format::parse(&text, &path)? {
+            let slot = match sec.scatter {
+                ScatterType::Brdf => &mut brdf,
+                ScatterType::Btdf => &mut btdf,
+            };
+            if let Some((first, _)) = slot {
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "{} holds a second {} section (the first is in {}): give one of each at most",
+                        path.display(),
+                        sec.scatter.keyword(),
+                        first.display()
+                    ),
+                ));
+            }
+            *slot = Some((path.clone(), Arc::new(Table::new(&sec, &path)?)));
+        }
+    }
+    Ok((brdf, btdf))
 }
 
 /// The reflected and transmitted TIS may not add up to more than 1 at any of either

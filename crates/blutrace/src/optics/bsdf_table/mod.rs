@@ -44,7 +44,7 @@ use format::{ScatterType, Section};
 use glam::DVec3;
 use sample::{BlockSampler, Frame, Grid, Incidence};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::TAU;
+use std::f64::consts::{FRAC_PI_2, TAU};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -106,8 +106,10 @@ impl Table {
         let aoi: Vec<f64> = sec.aoi.iter().map(|a| a.to_radians()).collect();
         let mut blocks = Vec::with_capacity(sec.blocks.len());
         for (k, b) in sec.blocks.iter().enumerate() {
-            let theta = aoi[k % aoi.len()];
-            let s = BlockSampler::new(&grid, theta, b.tis, &b.values);
+            let i = k % aoi.len();
+            let lo = if i == 0 { 0.0 } else { aoi[i - 1] };
+            let hi = aoi.get(i + 1).copied().unwrap_or(FRAC_PI_2);
+            let s = BlockSampler::new(&grid, aoi[i], (lo, hi), b.tis, &b.values);
             if s.is_none() && b.tis > 0.0 {
                 bail!(
                     "{}: line {}: TIS {} of the {} block at AOI {} deg, rotation {} deg, but no value of it lies above the surface",

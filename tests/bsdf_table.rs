@@ -417,7 +417,7 @@ fn the_content_hash_covers_the_table() {
 
 /// The stack of the GGX film test: a 0.2 mm PET film (GGX top, smooth bottom; 400 x 400
 /// mm, so its edges see almost no light) at z = 0..0.2 over an LED at z = -5 and a
-/// Lambertian reflector at z = -6, a detector at z = 1. `film` is the bottom face's
+/// Lambertian reflector at z = -6, a detector at z = 1 covering the film. `film` is the bottom face's
 /// table and `top` the top face's.
 fn stack(
     name: &str,
@@ -447,8 +447,8 @@ fn stack(
          [surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\n\
          [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, -5.0]\nnormal = [0.0, 0.0, 1.0]\n\
          u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
-         [detector]\norigin = [-60.0, -60.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-         size_mm = [120.0, 120.0]\nbins = [4, 4]\nangular_bins = [6, 4]\n"
+         [detector]\norigin = [-200.0, -200.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [400.0, 400.0]\nbins = [4, 4]\nangular_bins = [6, 4]\n"
     );
     let (b, t, s) = (
         quad(0.0, "film_bottom", false),
@@ -509,10 +509,16 @@ fn a_table_characterised_from_a_ggx_film_traces_like_the_film() {
     let frac = |r: &RunResult| r.tally.ledger.detected.sum.value() / n;
     let (df, dt) = (frac(&film), frac(&tab));
     let sigma = (df * (1.0 - df) / n + dt * (1.0 - dt) / n).sqrt();
+    eprintln!(
+        "GGX film: detected {df} (film) vs {dt} (table), sigma {sigma}; polar film {:?} table {:?}",
+        polar_sums(&film),
+        polar_sums(&tab)
+    );
     // Within 3 standard errors plus the table's approximation (AOI interpolation, 2 x 10
-    // degree cells, no lateral spread in a 0.2 mm film): 0.5 % of the detected power.
+    // degree cells; the target covers the film, so the lateral spread the table drops
+    // does not show): 0.2 % of the detected power. Measured: 0.96103 vs 0.96135.
     assert!(
-        df > 0.3 && (df - dt).abs() < 3.0 * sigma + 0.005 * df,
+        df > 0.9 && (df - dt).abs() < 3.0 * sigma + 0.002 * df,
         "film {df} vs table {dt} (sigma {sigma})"
     );
     // The angular distribution on the target: the power per polar bin (photons of
@@ -527,11 +533,12 @@ fn a_table_characterised_from_a_ggx_film_traces_like_the_film() {
     }
 }
 
-/// The detected weight per polar bin of the angular tally (summed over azimuth).
+/// The detected weight per polar bin of the angular tally (its theta runs fastest),
+/// summed over azimuth.
 fn polar_sums(r: &RunResult) -> Vec<f64> {
     let g = &r.tally.angular;
-    (0..g.ny)
-        .map(|j| (0..g.nx).map(|i| g.bins[j * g.nx + i].sum.value()).sum())
+    (0..g.nx)
+        .map(|i| (0..g.ny).map(|j| g.bins[j * g.nx + i].sum.value()).sum())
         .collect()
 }
 

@@ -21,9 +21,11 @@
 //! the cells give it; the TIS gives the power (the table's values, as other tracers read
 //! them, set the shape only).
 //!
-//! Between the table's angles of incidence the BSDF is interpolated linearly (one of the
-//! two neighbouring blocks is drawn with the weight of its share); outside them the
-//! nearest block is used. Sample rotations (the orientation of the plane of incidence on
+//! Between the table's angles of incidence the BSDF is interpolated linearly at each
+//! outgoing direction (one of the two neighbouring blocks is drawn with the weight of its
+//! share, and scatters as at its own AOI); outside them the nearest block is used. A
+//! sharp (glossy) peak therefore does not move between two AOIs but fades from one
+//! node's place to the next: such tables need a fine AOI grid. Sample rotations (the orientation of the plane of incidence on
 //! the face, measured from `u_axis` towards `normal x u_axis`) take the nearest block;
 //! `u_axis` defaults to the world x axis projected onto the face (the y axis where the
 //! face's normal is within 26 degrees of x). Monochrome tables only.
@@ -44,7 +46,7 @@ use format::{ScatterType, Section};
 use glam::DVec3;
 use sample::{BlockSampler, Frame, Grid, Incidence};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -106,10 +108,7 @@ impl Table {
         let aoi: Vec<f64> = sec.aoi.iter().map(|a| a.to_radians()).collect();
         let mut blocks = Vec::with_capacity(sec.blocks.len());
         for (k, b) in sec.blocks.iter().enumerate() {
-            let i = k % aoi.len();
-            let lo = if i == 0 { 0.0 } else { aoi[i - 1] };
-            let hi = aoi.get(i + 1).copied().unwrap_or(FRAC_PI_2);
-            let s = BlockSampler::new(&grid, aoi[i], (lo, hi), b.tis, &b.values);
+            let s = BlockSampler::new(&grid, aoi[k % aoi.len()], b.tis, &b.values);
             if s.is_none() && b.tis > 0.0 {
                 bail!(
                     "{}: line {}: TIS {} of the {} block at AOI {} deg, rotation {} deg, but no value of it lies above the surface",
@@ -169,12 +168,16 @@ impl Table {
     }
 
     /// A scattered direction for a photon meeting the face as `inc` says (`None`: the
-    /// table holds no scatter there).
+    /// table holds no scatter there): one of the two blocks about its AOI, drawn in
+    /// proportion to its share of the interpolated TIS, sampled in the frame of that
+    /// block's own AOI, so that the BSDF at each outgoing direction is interpolated
+    /// linearly in the angle of incidence.
     pub fn sample(&self, inc: &Incidence, rng: &mut PhotonRng) -> Option<DVec3> {
         let (a, b, t) = self.bracket(self.rotation(inc.rotation), inc.theta);
         let (ta, tb) = ((1.0 - t) * self.tis_of(a), t * self.tis_of(b));
         let k = if rng.uniform() * (ta + tb) < tb { b } else { a };
-        let frame = Frame::new(self.kind, inc);
+        let own = self.aoi[k % self.aoi.len()];
+        let frame = Frame::new(self.kind, &inc.at_angle(own));
         self.blocks[k].as_ref()?.sample(&self.grid, &frame, rng)
     }
 }

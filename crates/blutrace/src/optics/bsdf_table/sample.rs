@@ -25,22 +25,21 @@
 //! The directions of a block are drawn exactly from the density `f cos+ / integral`
 //! (`f` the cell's BSDF, `cos+` the cosine to the outgoing normal, 0 below the surface)
 //! by rejection: a cell is drawn with probability proportional to `f A c_max` (`A` its
-//! solid angle, `c_max` a bound on `cos+` over it for every AOI the block serves, from
-//! the closed-form maximum at each AOI), a direction uniformly over its solid angle, kept
-//! with probability `cos+ / c_max`; any bound gives the exact density, a tight one few
-//! rejections. The power that leaves is the block's TIS: the table's values set the
-//! shape only. A photon between two blocks' AOIs draws one of them (see
-//! [`super::Table`]), in its own frame: the two blocks' shapes, each normalised at the
-//! photon's AOI, mixed in proportion to their share of the interpolated TIS.
+//! solid angle, `c_max` the largest `cos+` over it, in closed form), a direction
+//! uniformly over its solid angle, kept with probability `cos+ / c_max`. The power that
+//! leaves is the block's TIS: the table's values set the shape only. A block draws its
+//! directions in the frame of its own AOI (the photon's plane of incidence and side):
+//! a photon between two blocks' AOIs draws one of them in proportion to its share of the
+//! interpolated TIS, which is the BSDF interpolated linearly in the angle of incidence at
+//! each outgoing direction ([`super::Table::sample`]).
 
 use super::format::ScatterType;
 use crate::rng::PhotonRng;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
-/// Draws before a block gives up (the photon is then absorbed): reached only where a
-/// block has no value above the surface at the photon's AOI (its own AOI has, or the
-/// table is refused).
+/// Draws before a block gives up (never reached by a table that passed its build
+/// checks: each cell it can draw has directions above the surface).
 pub const MAX_TRIES: usize = 10_000;
 
 /// How a photon meets a face: the angles that pick the table's block and the frame its
@@ -58,6 +57,18 @@ pub struct Incidence {
     pub t: DVec3,
     /// The photon's unit direction.
     pub d: DVec3,
+}
+
+impl Incidence {
+    /// The same arrival (plane of incidence, side, rotation) at the angle `theta`.
+    pub fn at_angle(&self, theta: f64) -> Incidence {
+        let (st, ct) = theta.sin_cos();
+        Incidence {
+            theta,
+            d: (st * self.t - ct * self.n).normalize(),
+            ..*self
+        }
+    }
 }
 
 /// The [`Incidence`] of a photon along unit `d` at a face of facing unit normal `n`
@@ -262,23 +273,6 @@ fn max_cos(theta: f64, (r_lo, r_hi): (f64, f64), (phi_lo, width): (f64, f64)) ->
     (best + 1e-12).clamp(0.0, 1.0)
 }
 
-/// A bound on `cos+` over a cell for every angle of incidence in `span` (radians):
-/// [`max_cos`] on a 0.5 degree grid of incidences plus half a step (the cosine changes at
-/// most as fast as the angle), at most 1.
-fn max_cos_over(span: (f64, f64), r: (f64, f64), az: (f64, f64)) -> f64 {
-    let width = (span.1 - span.0).max(0.0);
-    let steps = (width / 0.5f64.to_radians()).ceil().max(1.0) as usize;
-    let h = width / steps as f64;
-    let best = (0..=steps)
-        .map(|i| max_cos(span.0 + h * i as f64, r, az))
-        .fold(0.0, f64::max);
-    if best > 0.0 {
-        (best + 0.5 * h).min(1.0)
-    } else {
-        best
-    }
-}
-
 /// One (rotation, AOI) block ready to sample.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BlockSampler {
@@ -291,33 +285,22 @@ pub struct BlockSampler {
 }
 
 impl BlockSampler {
-    /// The sampler of a block of BSDF `values[azimuth][radial]` on `grid`, measured at
-    /// the AOI `own` and used for photons arriving at AOIs within `span` (radians: the
-    /// neighbouring blocks' AOIs, or 0 and 90 degrees beyond the ends); `None` when no
-    /// cell has directions above the surface at `own`.
-    pub fn new(
-        grid: &Grid,
-        own: f64,
-        span: (f64, f64),
-        tis: f64,
-        values: &[Vec<f64>],
-    ) -> Option<BlockSampler> {
+    /// The sampler of a block of BSDF `values[azimuth][radial]` on `grid` at its AOI
+    /// `theta` (radians); `None` when no cell has directions above the surface.
+    pub fn new(grid: &Grid, theta: f64, tis: f64, values: &[Vec<f64>]) -> Option<BlockSampler> {
         let n_r = grid.n_radial();
         let (mut cdf, mut c_max) = (Vec::new(), Vec::new());
-        let (mut total, mut at_own) = (0.0, 0.0);
+        let mut total = 0.0;
         for (ia, row) in values.iter().enumerate() {
             for (ir, f) in row.iter().enumerate().take(n_r) {
                 let r = (grid.radial_edges[ir], grid.radial_edges[ir + 1]);
-                let az = (grid.az_lo[ia], grid.az_width[ia]);
-                let c = max_cos_over(span, r, az);
-                let a = f * grid.solid_angle(ia, ir);
-                total += a * c;
-                at_own += a * (max_cos(own, r, az) - 1e-12).max(0.0);
+                let c = max_cos(theta, r, (grid.az_lo[ia], grid.az_width[ia]));
+                total += f * grid.solid_angle(ia, ir) * c;
                 cdf.push(total);
                 c_max.push(c);
             }
         }
-        (at_own > 0.0).then_some(BlockSampler { tis, cdf, c_max })
+        (total > 0.0).then_some(BlockSampler { tis, cdf, c_max })
     }
 
     /// A direction drawn from the block's `f cos+` density in `frame` (`None`: gave up

@@ -77,7 +77,8 @@ pub struct Fates {
 pub struct Characterised {
     /// What the part was found to be (for the file's comments and the report).
     pub part: String,
-    /// The BRDF and BTDF sections.
+    /// The BRDF and BTDF sections (a type no photon took is left out: an opaque part
+    /// has no BTDF, so its table needs no `inside`).
     pub sections: Vec<Section>,
     /// Per (rotation, AOI), rotation-major: fractions of the photons.
     pub fates: Vec<Fates>,
@@ -396,10 +397,13 @@ pub fn characterise(scene: &Scene, opts: &Options) -> Result<Characterised> {
     };
     Ok(Characterised {
         part: part.describe(&opts.tag),
-        sections: vec![
+        sections: [
             section(ScatterType::Brdf, blocks.0),
             section(ScatterType::Btdf, blocks.1),
-        ],
+        ]
+        .into_iter()
+        .filter(|s| s.blocks.iter().any(|b| b.tis > 0.0))
+        .collect(),
         fates,
     })
 }

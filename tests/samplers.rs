@@ -350,6 +350,7 @@ fn measured_led_directions_follow_the_intensity_profile() {
             name: what.into(),
             power_w: 1.0,
             lumens: None,
+            spectrum: None,
             emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal,

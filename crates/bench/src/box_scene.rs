@@ -330,7 +330,7 @@ fn dots_of(scene: &Scene, face_tag: &[usize; 6], lo: DVec3, hi: DVec3) -> Result
                 if found.is_some() {
                     bail!(refuse(scene, "dots on more than one face"));
                 }
-                found = Some((f, &d.pattern, d.ink_albedo));
+                found = Some((f, &d.pattern, d.ink_albedo.clone()));
             }
             other => bail!(refuse(
                 scene,
@@ -407,7 +407,7 @@ fn sheet_of(scene: &Scene, prims: &[u32], tol: f64) -> Result<(AaRect, f32, usiz
     {
         bail!(refuse(scene, "more than one part besides the guide"));
     }
-    let SurfaceModel::Lambert(Lambert { albedo }) = scene.surfaces[tag] else {
+    let SurfaceModel::Lambert(Lambert { albedo }) = &scene.surfaces[tag] else {
         bail!(refuse(
             scene,
             format!("tag '{}' is not a Lambertian sheet", scene.tags[tag])

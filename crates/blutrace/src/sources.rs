@@ -10,6 +10,7 @@
 //! name = "left_upper"        # for reports (default: the type and the entry's index)
 //! power_w = 1.0              # radiant power (W)
 //! lumens = 300.0             # optional: luminous flux, for luminance outputs
+//! spectrum = "cie-led-b5"    # optional: the emission spectrum (see `spectrum`)
 //! medium = "air"             # what the source emits into
 //! body = { model = "lambert", albedo = 0.5 }   # what returning light meets: see `body`
 //! array = { count = 4, pitch_mm = 10.0, direction = [0.0, 1.0, 0.0] }   # a row
@@ -21,6 +22,7 @@ pub mod body_shape;
 pub mod ccfl;
 pub mod intensity;
 pub mod led;
+pub mod spectrum;
 
 use crate::geometry::Ray;
 use crate::optics::medium::{Medium, MediumId, medium_id};
@@ -34,7 +36,9 @@ use ccfl::{CcflSpec, Tube};
 use glam::DVec3;
 use led::{FlatLed, LedSpec};
 use serde::{Deserialize, Serialize};
+use spectrum::{EmissionSpectrum, SpectrumSpec};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// `[[sources]]`: a light source in the scene file.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -51,6 +55,7 @@ struct Common<'a> {
     name: &'a Option<String>,
     power_w: f64,
     lumens: Option<f64>,
+    spectrum: Option<&'a SpectrumSpec>,
     medium: &'a str,
     body: &'a BodySpec,
     package_depth_mm: Option<f64>,
@@ -68,10 +73,13 @@ impl SourceSpec {
     /// The files the source reads, relative to the scene file (its measured intensity
     /// table): the content hash covers their bytes, as it does surface models' tables.
     pub fn files(&self) -> Vec<PathBuf> {
-        match self {
+        let mut files: Vec<PathBuf> = match self {
             SourceSpec::Led(s) => s.intensity_file.iter().cloned().collect(),
             SourceSpec::Ccfl(_) => Vec::new(),
-        }
+        };
+        let spectrum = self.common().spectrum.and_then(SpectrumSpec::file);
+        files.extend(spectrum.map(PathBuf::from));
+        files
     }
 
     /// The type's name in the scene file.
@@ -88,6 +96,7 @@ impl SourceSpec {
                 name: &s.name,
                 power_w: s.power_w,
                 lumens: s.lumens,
+                spectrum: s.spectrum.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: None,
@@ -96,6 +105,7 @@ impl SourceSpec {
                 name: &s.name,
                 power_w: s.power_w,
                 lumens: s.lumens,
+                spectrum: s.spectrum.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: s.package_depth_mm,
@@ -117,6 +127,16 @@ impl SourceSpec {
             .package_depth_mm
             .map(|d| ctx.length(&f("package_depth_mm"), d))
             .transpose()?;
+        let spectrum = common
+            .spectrum
+            .map(|s| s.build(ctx, &f("spectrum")))
+            .transpose()?;
+        if spectrum.is_some() && common.lumens.is_some() {
+            return Err(ctx.err(
+                &f("lumens"),
+                "follows from the spectrum (683 lm/W times its V-weighted fraction); give lumens only for a source without one",
+            ));
+        }
         let body = common
             .body
             .model(ctx, &f("body"), media)?
@@ -128,6 +148,7 @@ impl SourceSpec {
             },
             power_w: ctx.positive(&f("power_w"), common.power_w)?,
             lumens: ctx.optional_positive(&f("lumens"), common.lumens)?,
+            spectrum: spectrum.map(Arc::new),
             emitter,
             medium: medium_id(ctx, &f("medium"), common.medium, media)?,
             body,
@@ -229,6 +250,8 @@ pub struct Source {
     pub power_w: f64,
     /// Luminous flux (lm), when the scene gives it.
     pub lumens: Option<f64>,
+    /// Its emission spectrum (`None`: monochrome light).
+    pub spectrum: Option<Arc<EmissionSpectrum>>,
     /// Shape and angular profile.
     pub emitter: Emitter,
     /// Medium the source emits into.
@@ -264,6 +287,14 @@ impl Source {
         self.emitter.translate(d);
         if let Some(b) = &mut self.body {
             b.shape.translate(d);
+        }
+    }
+
+    /// Luminous flux (lm): from its spectrum, or as the scene gives it.
+    pub fn luminous_flux(&self) -> Option<f64> {
+        match &self.spectrum {
+            Some(s) => Some(self.power_w * s.efficacy_lm_per_w()),
+            None => self.lumens,
         }
     }
 
@@ -327,7 +358,13 @@ impl Sources {
                 format!("total power_w {total:e} W exceeds {MAX_TOTAL_POWER_W:e} W"),
             ));
         }
+        check_spectra(ctx, specs)?;
         Ok(Self::new(list))
+    }
+
+    /// Whether the sources have spectra (then every one has).
+    pub fn spectral(&self) -> bool {
+        self.list.iter().any(|s| s.spectrum.is_some())
     }
 
     /// Move every source (and its body) by `d`.
@@ -335,9 +372,10 @@ impl Sources {
         self.list.iter_mut().for_each(|s| s.translate(d));
     }
 
-    /// Luminous efficacy of the radiation (lm/W) when every source gives its lumens.
+    /// Luminous efficacy of the radiation (lm/W) when every source gives its lumens or
+    /// its spectrum.
     pub fn luminous_efficacy(&self) -> Option<f64> {
-        let lumens: Option<f64> = self.list.iter().map(|s| s.lumens).sum();
+        let lumens: Option<f64> = self.list.iter().map(Source::luminous_flux).sum();
         lumens.map(|lm| lm / self.total_power())
     }
 
@@ -355,12 +393,16 @@ impl Sources {
             .min(self.list.len() - 1);
         let s = &self.list[i];
         let (ray, normal) = s.emit(rng);
+        let light = match &s.spectrum {
+            Some(sp) => Light::at_nm(sp.sample(rng.uniform())),
+            None => Light::MONOCHROME,
+        };
         Emission {
             ray,
             normal,
             medium: s.medium,
             source: i,
-            light: Light::MONOCHROME,
+            light,
         }
     }
 
@@ -373,6 +415,22 @@ impl Sources {
     }
 }
 
+/// Either every source has a spectrum or none has: a photon of a monochrome source has no
+/// colour to add to a spectral one's.
+fn check_spectra(ctx: &Ctx, specs: &[SourceSpec]) -> Result<()> {
+    let has = |s: &SourceSpec| s.common().spectrum.is_some();
+    let (Some(with), Some(without)) = (
+        specs.iter().position(has),
+        specs.iter().position(|s| !has(s)),
+    ) else {
+        return Ok(());
+    };
+    Err(ctx.err(
+        &format!("sources[{without}].spectrum"),
+        format!("missing: sources[{with}] has a spectrum, so every source needs one (a monochrome source has no colour to add)"),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -383,6 +441,7 @@ mod tests {
             name: "l".into(),
             power_w: p,
             lumens: None,
+            spectrum: None,
             emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal: DVec3::Z,

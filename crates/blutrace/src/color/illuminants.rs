@@ -37,11 +37,14 @@ pub enum CieIlluminant {
     LedV1,
     /// LED-V2: violet-pumped phosphor LED, 2700 K.
     LedV2,
+    /// FL11: narrow-band tri-phosphor fluorescent lamp, 4000 K (CIE 015:2018 Table 10.1,
+    /// 380-780 nm at 5 nm).
+    Fl11,
 }
 
 impl CieIlluminant {
     /// Every illuminant, in the order of this enum.
-    pub const ALL: [CieIlluminant; 11] = [
+    pub const ALL: [CieIlluminant; 12] = [
         CieIlluminant::D65,
         CieIlluminant::A,
         CieIlluminant::LedB1,
@@ -53,6 +56,7 @@ impl CieIlluminant {
         CieIlluminant::LedRgb1,
         CieIlluminant::LedV1,
         CieIlluminant::LedV2,
+        CieIlluminant::Fl11,
     ];
 
     /// The name: `"cie-d65"`, `"cie-a"`, `"cie-led-b1"` ... `"cie-led-v2"`.
@@ -69,6 +73,7 @@ impl CieIlluminant {
             CieIlluminant::LedRgb1 => "cie-led-rgb1",
             CieIlluminant::LedV1 => "cie-led-v1",
             CieIlluminant::LedV2 => "cie-led-v2",
+            CieIlluminant::Fl11 => "cie-fl11",
         }
     }
 
@@ -93,9 +98,26 @@ impl CieIlluminant {
             CieIlluminant::LedRgb1 => led(&LED_RGB1),
             CieIlluminant::LedV1 => led(&LED_V1),
             CieIlluminant::LedV2 => led(&LED_V2),
+            CieIlluminant::Fl11 => uniform(380.0, 5.0, &FL11),
         }
     }
 }
+
+/// CIE illuminant FL11 (CIE 015:2018 Table 10.1, the values of CIE 15.2-1986 Table 1.5), at
+/// 5 nm from 380 to 780 nm: a tri-band lamp of the rare-earth phosphors backlight CCFLs use
+/// (Eu³⁺ red near 611 nm, Tb³⁺ green near 544 nm, Eu²⁺ blue) with the mercury lines.
+#[rustfmt::skip]
+const FL11: [f64; 81] = [
+    0.91, 0.63, 0.46, 0.37, 1.29, 12.68, 1.59, 1.79, 2.46, 3.33,
+    4.49, 33.94, 12.13, 6.95, 7.19, 7.12, 6.72, 6.13, 5.46, 4.79,
+    5.66, 14.29, 14.96, 8.97, 4.72, 2.33, 1.47, 1.10, 0.89, 0.83,
+    1.18, 4.90, 39.59, 72.84, 32.61, 7.52, 2.83, 1.96, 1.67, 4.43,
+    11.28, 14.76, 12.73, 9.74, 7.33, 9.72, 55.27, 42.58, 13.18, 13.16,
+    12.26, 5.11, 2.07, 2.34, 3.58, 3.01, 2.48, 2.14, 1.54, 1.33,
+    1.46, 1.94, 2.00, 1.20, 1.35, 4.10, 5.58, 2.51, 0.57, 0.27,
+    0.23, 0.21, 0.24, 0.24, 0.20, 0.24, 0.32, 0.26, 0.16, 0.12,
+    0.09,
+];
 
 fn uniform(first_nm: f64, step_nm: f64, values: &[f64]) -> Spectrum {
     Spectrum::uniform(first_nm, step_nm, values).expect("the CIE tables are valid")

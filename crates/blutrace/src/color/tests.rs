@@ -93,6 +93,18 @@ fn the_cie_led_illuminants_have_cie_15s_chromaticities() {
 }
 
 #[test]
+fn fl11_the_tri_phosphor_lamp_has_cie_15s_chromaticity() {
+    // CIE 015:2018 Table 10.3: FL11 x = 0.3805, y = 0.3769 (5 nm summation, as published).
+    let xy = xy_summed_5nm(&CieIlluminant::Fl11.spectrum());
+    assert_near("cie-fl11", xy.x, 0.3805, 1e-4);
+    assert_near("cie-fl11", xy.y, 0.3769, 1e-4);
+    assert_eq!(
+        CieIlluminant::from_name("cie-fl11"),
+        Some(CieIlluminant::Fl11)
+    );
+}
+
+#[test]
 fn equal_energy_is_at_one_third() {
     // The CMFs' integrals are equal to 4e-4 relative (106.8655, 106.8569, 106.8923), so
     // illuminant E lands within 5e-5 of 1/3 (0.333314, 0.333288); a swapped or wrong column

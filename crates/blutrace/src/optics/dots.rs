@@ -54,7 +54,7 @@ use super::density::{check_pitch, check_span};
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 pub use super::placement::Placement;
-use super::spectrum::Spectral;
+use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{dielectric, lambert};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -73,7 +73,7 @@ pub struct DotsSpec {
     #[serde(default = "air")]
     pub outside: String,
     /// Ink albedo (Lambertian).
-    pub ink_albedo: f64,
+    pub ink_albedo: SpectralValue,
     /// Cell lattice.
     pub lattice: Lattice,
     /// Cell pitch (mm).
@@ -145,7 +145,7 @@ impl Surface for Dots {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         if self.pattern.meets_ink(at.hit.point, rng) {
-            let ink = at.reflect(self.ink_albedo, rng, |rng| lambert::back(at, rng));
+            let ink = at.reflect(&self.ink_albedo, rng, |rng| lambert::back(at, rng));
             return (ink, Feature::Ink);
         }
         (dielectric::smooth(at, &self.interface, rng), Feature::Plain)
@@ -216,7 +216,9 @@ impl SurfaceSpecOf for DotsSpec {
         Ok(Dots {
             interface: Interface::build(ctx, at, &self.inside, &self.outside, media)?,
             pattern,
-            ink_albedo: ctx.fraction(&f("ink_albedo"), self.ink_albedo)?.into(),
+            ink_albedo: self
+                .ink_albedo
+                .build(ctx, &f("ink_albedo"), Range::Fraction)?,
         })
     }
 }

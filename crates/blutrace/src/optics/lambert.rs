@@ -11,7 +11,7 @@
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::sampling;
-use super::spectrum::Spectral;
+use super::spectrum::{Range, Spectral, SpectralValue};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -22,12 +22,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LambertSpec {
-    /// Albedo.
-    pub albedo: f64,
+    /// Albedo: a number or a table over wavelength ([`super::spectrum`]).
+    pub albedo: SpectralValue,
 }
 
 /// A Lambertian scatterer.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Lambert {
     /// Diffuse reflectance.
     pub albedo: Spectral,
@@ -37,10 +37,10 @@ impl SurfaceSpecOf for LambertSpec {
     type Model = Lambert;
 
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Lambert> {
-        let albedo = ctx.fraction(&format!("{at}.albedo"), self.albedo)?;
-        Ok(Lambert {
-            albedo: albedo.into(),
-        })
+        let albedo = self
+            .albedo
+            .build(ctx, &format!("{at}.albedo"), Range::Fraction)?;
+        Ok(Lambert { albedo })
     }
 }
 
@@ -48,7 +48,7 @@ impl Surface for Lambert {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         (
-            at.reflect(self.albedo, rng, |rng| back(at, rng)),
+            at.reflect(&self.albedo, rng, |rng| back(at, rng)),
             Feature::Plain,
         )
     }

@@ -29,7 +29,7 @@
 
 use super::phase::{self, PhaseTable};
 use super::sampling;
-use super::spectrum::{Light, Spectral};
+use super::spectrum::{Light, Range, Spectral, SpectralValue};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -141,11 +141,11 @@ pub struct Interface {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumSpec {
-    /// Refractive index.
-    pub n: f64,
-    /// Beer-Lambert absorption coefficient (1/mm).
-    #[serde(default)]
-    pub absorption_per_mm: f64,
+    /// Refractive index: a number, a table or a dispersion formula ([`super::spectrum`]).
+    pub n: SpectralValue,
+    /// Beer-Lambert absorption coefficient (1/mm): a number or a table.
+    #[serde(default = "no_absorption")]
+    pub absorption_per_mm: SpectralValue,
     /// Scattering coefficient mu_s (1/mm).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub scattering_per_mm: f64,
@@ -181,6 +181,10 @@ pub struct ParticlesSpec {
 
 fn default_wavelength_nm() -> f64 {
     550.0
+}
+
+fn no_absorption() -> SpectralValue {
+    SpectralValue::Constant(0.0)
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -225,9 +229,10 @@ impl MediumSpec {
     /// The checked medium `name`.
     fn build(&self, ctx: &Ctx, name: &str) -> Result<Medium> {
         let field = |f: &str| format!("media.{name}.{f}");
-        let n = ctx.positive(&field("n"), self.n)?;
+        let n = self.n.build(ctx, &field("n"), Range::Index)?;
         let mut absorption =
-            ctx.non_negative(&field("absorption_per_mm"), self.absorption_per_mm)?;
+            self.absorption_per_mm
+                .build(ctx, &field("absorption_per_mm"), Range::NonNegative)?;
         let mu_s = ctx.non_negative(&field("scattering_per_mm"), self.scattering_per_mm)?;
         let g = ctx.finite(&field("anisotropy"), self.anisotropy)?;
         if g.abs() >= 1.0 {
@@ -260,8 +265,8 @@ impl MediumSpec {
                     "give either particles or scattering_per_mm and anisotropy, not both",
                 ));
             }
-            let bulk = p.bulk(ctx, &field("particles"), n)?;
-            absorption += bulk.absorption_per_mm;
+            let bulk = p.bulk(ctx, &field("particles"), n.nominal())?;
+            absorption = absorption.plus(&Spectral::constant(bulk.absorption_per_mm));
             scattering = Scattering {
                 per_mm: bulk.scattering_per_mm,
                 anisotropy: bulk.anisotropy,
@@ -270,8 +275,8 @@ impl MediumSpec {
         }
         Ok(Medium {
             name: name.to_string(),
-            n: Spectral::constant(n),
-            absorption_per_mm: Spectral::constant(absorption),
+            n,
+            absorption_per_mm: absorption,
             scattering,
             particles: self.particles.clone(),
         })

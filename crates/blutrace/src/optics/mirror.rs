@@ -9,7 +9,7 @@
 use super::fresnel;
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
-use super::spectrum::Spectral;
+use super::spectrum::{Range, Spectral, SpectralValue};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -22,15 +22,15 @@ use serde::{Deserialize, Serialize};
 pub struct MirrorSpec {
     /// Reflectance.
     #[serde(default = "one")]
-    pub reflectance: f64,
+    pub reflectance: SpectralValue,
 }
 
-fn one() -> f64 {
-    1.0
+fn one() -> SpectralValue {
+    SpectralValue::Constant(1.0)
 }
 
 /// A specular mirror.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mirror {
     /// Reflectance.
     pub reflectance: Spectral,
@@ -40,10 +40,10 @@ impl SurfaceSpecOf for MirrorSpec {
     type Model = Mirror;
 
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Mirror> {
-        let reflectance = ctx.fraction(&format!("{at}.reflectance"), self.reflectance)?;
-        Ok(Mirror {
-            reflectance: reflectance.into(),
-        })
+        let reflectance =
+            self.reflectance
+                .build(ctx, &format!("{at}.reflectance"), Range::Fraction)?;
+        Ok(Mirror { reflectance })
     }
 }
 
@@ -51,7 +51,7 @@ impl Surface for Mirror {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let facing = at.facing();
-        let out = at.reflect(self.reflectance, rng, |_| Some(direction(at.dir, facing)));
+        let out = at.reflect(&self.reflectance, rng, |_| Some(direction(at.dir, facing)));
         (out, Feature::Plain)
     }
 }

@@ -109,7 +109,7 @@ impl Arrival<'_> {
     #[inline]
     pub fn reflect(
         &self,
-        albedo: Spectral,
+        albedo: &Spectral,
         rng: &mut PhotonRng,
         sample: impl FnOnce(&mut PhotonRng) -> Option<DVec3>,
     ) -> Outcome {

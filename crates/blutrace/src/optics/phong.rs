@@ -13,7 +13,7 @@
 
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
-use super::spectrum::Spectral;
+use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{fresnel, lambert, sampling};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct PhongSpec {
     /// Total reflectance.
-    pub reflectance: f64,
+    pub reflectance: SpectralValue,
     /// Specular fraction of the reflected energy.
     pub specular: f64,
     /// Phong exponent.
@@ -34,7 +34,7 @@ pub struct PhongSpec {
 }
 
 /// A Phong reflector (lamp reflector, reflector sheet).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Phong {
     /// Total reflectance (diffuse + specular).
     pub reflectance: Spectral,
@@ -50,7 +50,9 @@ impl SurfaceSpecOf for PhongSpec {
     fn build(&self, ctx: &Ctx, at: &str, _media: &[Medium]) -> Result<Phong> {
         let f = |k: &str| format!("{at}.{k}");
         Ok(Phong {
-            reflectance: ctx.fraction(&f("reflectance"), self.reflectance)?.into(),
+            reflectance: self
+                .reflectance
+                .build(ctx, &f("reflectance"), Range::Fraction)?,
             specular: ctx.fraction(&f("specular"), self.specular)?,
             exponent: ctx.positive(&f("exponent"), self.exponent)?,
         })
@@ -61,7 +63,7 @@ impl Surface for Phong {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let facing = at.facing();
-        let out = at.reflect(self.reflectance, rng, |rng| {
+        let out = at.reflect(&self.reflectance, rng, |rng| {
             self.direction(facing, at.dir, rng)
         });
         (out, Feature::Plain)

@@ -91,6 +91,7 @@ mod tests {
             name: "lamp".into(),
             power_w: 2.0,
             lumens: None,
+            spectrum: None,
             emitter: Emitter::Ccfl(Tube {
                 center: DVec3::new(10.0, 0.0, 5.0),
                 axis: DVec3::Y,

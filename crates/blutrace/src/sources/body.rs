@@ -200,7 +200,7 @@ mod tests {
         let SurfaceSpec::Lambert(l) = spec.as_ref() else {
             panic!("{b:?}")
         };
-        assert_eq!(l.albedo, 0.45);
+        assert_eq!(l.albedo.constant(), Some(0.45));
         let text = toml::to_string(&Holder { body: b }).unwrap();
         let again = parse(&text).unwrap();
         assert!(

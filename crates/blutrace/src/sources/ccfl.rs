@@ -43,6 +43,9 @@ pub struct CcflSpec {
     pub power_w: f64,
     /// Luminous flux (lm), for luminance outputs.
     pub lumens: Option<f64>,
+    /// Emission spectrum ([`super::spectrum`]); without it the source is monochrome.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectrum: Option<super::spectrum::SpectrumSpec>,
     /// Medium around the tube.
     #[serde(default = "air")]
     pub medium: String,

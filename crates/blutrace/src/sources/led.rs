@@ -51,6 +51,9 @@ pub struct LedSpec {
     pub power_w: f64,
     /// Luminous flux (lm), for luminance outputs.
     pub lumens: Option<f64>,
+    /// Emission spectrum ([`super::spectrum`]); without it the source is monochrome.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectrum: Option<super::spectrum::SpectrumSpec>,
     /// cos^m exponent (1 = Lambertian, 0 = isotropic over the hemisphere); default 1.
     /// Not with `intensity_file`.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -57,7 +57,7 @@ pub(super) enum Face<'a> {
 }
 
 /// A smooth interface with its two refractive indices.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(super) struct Smooth {
     iface: Interface,
     n_inside: Spectral,
@@ -73,7 +73,7 @@ pub(super) struct Walks<'a> {
 impl<'a> Walks<'a> {
     /// The walks of `scene` (none when the convex path is off).
     pub(super) fn new(scene: &'a Scene, convex: bool, bodies: &BodyBoxes) -> Walks<'a> {
-        let n = |m: MediumId| scene.media[m as usize].n;
+        let n = |m: MediumId| scene.media[m as usize].n.clone();
         let smooth = |iface: &Interface| Smooth {
             iface: *iface,
             n_inside: n(iface.inside),
@@ -88,7 +88,7 @@ impl<'a> Walks<'a> {
                     smooth: smooth(&d.interface),
                     pattern: &d.pattern,
                     radii: d.pattern.column_radii(),
-                    ink_albedo: d.ink_albedo,
+                    ink_albedo: d.ink_albedo.clone(),
                 },
                 _ => Face::Other,
             })

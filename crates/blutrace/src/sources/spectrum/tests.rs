@@ -1,0 +1,140 @@
+use super::*;
+use crate::color::observer;
+
+fn ctx() -> Ctx<'static> {
+    Ctx(Path::new("scene.toml"))
+}
+
+fn spec(text: &str) -> std::result::Result<SpectrumSpec, String> {
+    #[derive(Deserialize)]
+    struct Doc {
+        spectrum: SpectrumSpec,
+    }
+    toml::from_str::<Doc>(&format!("spectrum = {text}"))
+        .map(|d| d.spectrum)
+        .map_err(|e| e.to_string())
+}
+
+fn build(text: &str) -> std::result::Result<EmissionSpectrum, String> {
+    spec(text)?
+        .build(&ctx(), "sources[0].spectrum")
+        .map_err(|e| e.to_string())
+}
+
+/// The sampler inverts the cumulative integral: drawn wavelengths fall in 5 nm bins as
+/// often as the spectrum's integral over each bin says (chi-square over 94 bins, 1e6
+/// draws of a stratified uniform, so the statistic is far below its 0.999 quantile
+/// only when the inversion is right).
+#[test]
+fn drawn_wavelengths_follow_the_spectrum() {
+    let s = CieIlluminant::LedB3.spectrum();
+    let e = EmissionSpectrum::new(&s).unwrap();
+    let n = 1_000_000;
+    let mut counts = vec![0u64; 94];
+    for k in 0..n {
+        let nm = e.sample((k as f64 + 0.5) / n as f64);
+        counts[((nm - 360.0) / 5.0).min(93.0) as usize] += 1;
+    }
+    let total = s.integral();
+    let mut chi2 = 0.0;
+    for (b, &c) in counts.iter().enumerate() {
+        let lo = 360.0 + 5.0 * b as f64;
+        let box_ = Spectrum::from_rows(&[[lo, 1.0], [lo + 5.0, 1.0]]).unwrap();
+        let want = s.integrate_product(&box_) / total * n as f64;
+        if want > 0.0 {
+            chi2 += (c as f64 - want).powi(2) / want.max(1.0);
+        } else {
+            assert_eq!(c, 0, "bin {lo} nm has no power");
+        }
+    }
+    assert!(
+        chi2 < 1.0,
+        "stratified draws should match closely: chi2 {chi2}"
+    );
+}
+
+#[test]
+fn a_linear_ramp_inverts_in_closed_form() {
+    // S = nm - 400 on [400, 500]: CDF = (x-400)^2 / 100^2, so x = 400 + 100 sqrt(u).
+    let e = build("{ table = [[400, 0], [500, 100]] }").unwrap();
+    for u in [0.0, 0.01, 0.25, 0.5, 0.81, 0.999] {
+        assert!(
+            (e.sample(u) - (400.0 + 100.0 * f64::sqrt(u))).abs() < 1e-9,
+            "{u}"
+        );
+    }
+}
+
+#[test]
+fn efficacy_and_colour_follow_from_the_spectrum() {
+    let e = build("\"cie-led-b5\"").unwrap();
+    let s = CieIlluminant::LedB5.spectrum();
+    let want = 683.0 * s.integrate_product(&observer().y_bar) / s.integral();
+    assert!((e.efficacy_lm_per_w() - want).abs() < 1e-9 * want);
+    let xy = e.xyz_per_w().xy().unwrap();
+    assert!((xy.x - 0.3118).abs() < 1e-4 && (xy.y - 0.3236).abs() < 1e-4);
+    let tri = build("\"ccfl-triphosphor\"").unwrap();
+    assert_eq!(tri, build("\"cie-fl11\"").unwrap());
+}
+
+#[test]
+fn the_observer_reads_the_same_fast_and_slow() {
+    let o = observer();
+    for nm in [359.0, 360.0, 360.5, 555.0, 612.3, 829.9, 830.0, 831.0] {
+        let [x, y, z] = cmf_at(nm);
+        assert!((x - o.x_bar.at(nm)).abs() < 1e-15, "{nm}");
+        assert!((y - o.y_bar.at(nm)).abs() < 1e-15, "{nm}");
+        assert!((z - o.z_bar.at(nm)).abs() < 1e-15, "{nm}");
+    }
+}
+
+#[test]
+fn a_blackbody_keeps_its_visible_part() {
+    let e = build("{ blackbody_k = 6500 }").unwrap();
+    assert_eq!(e.range_nm(), VISIBLE_NM);
+    let xy = e.xyz_per_w().xy().unwrap();
+    // The Planckian locus at 6500 K: x 0.3135, y 0.3236 (CIE 015:2018 locus, c2 1.4388e-2).
+    assert!(
+        (xy.x - 0.3135).abs() < 5e-4 && (xy.y - 0.3236).abs() < 5e-4,
+        "{xy:?}"
+    );
+}
+
+#[test]
+fn spectrum_files_read_with_a_header_and_comments() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(
+        dir.path().join("led.csv"),
+        "nm,relative\n# measured\n450, 1.0\n550 0.5\n650,0.25\n",
+    )
+    .unwrap();
+    let c = Ctx(&scene);
+    let s = spec("{ file = \"led.csv\" }").unwrap();
+    assert_eq!(s.file(), Some(Path::new("led.csv")));
+    let e = s.build(&c, "sources[0].spectrum").unwrap();
+    assert_eq!(e.range_nm(), (450.0, 650.0));
+    std::fs::write(dir.path().join("led.csv"), "450, 1.0\n550, x\n").unwrap();
+    let err = s.build(&c, "sources[0].spectrum").unwrap_err().to_string();
+    assert!(
+        err.contains("led.csv line 2") && err.contains("sources[0].spectrum"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_spectra_are_named() {
+    let e = build("\"cie-led-b9\"").unwrap_err();
+    assert!(
+        e.contains("unknown spectrum 'cie-led-b9'") && e.contains("cie-led-b5"),
+        "{e}"
+    );
+    let e = build("{ table = [[900, 1], [1000, 1]] }").unwrap_err();
+    assert!(e.contains("no power within 360-830 nm"), "{e}");
+    let e = build("{ blackbody_k = -5 }").unwrap_err();
+    assert!(e.contains("blackbody_k"), "{e}");
+    let e = spec("{ tabel = [] }").unwrap_err();
+    assert!(e.contains("unknown key 'tabel'"), "{e}");
+    let e = build("{ file = \"missing.csv\" }").unwrap_err();
+    assert!(e.contains("cannot read"), "{e}");
+}

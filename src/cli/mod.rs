@@ -15,6 +15,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bsdf;
 mod check;
 mod enums;
 pub mod optimize;
@@ -69,6 +70,8 @@ enum Command {
         #[arg(long, default_value_t = 3, value_parser = blutrace::count::parse_rounds)]
         repeat: usize,
     },
+    /// Characterise a part of a scene (a film, a plate, a face) into an IS BSDF table.
+    Bsdf(bsdf::BsdfArgs),
     /// Validate a scene and print what it uses.
     Check {
         /// Scene file (or a folder holding scene.toml).
@@ -181,6 +184,7 @@ impl Command {
                 bench::bench(&scene, &box_scene, photons, threads, repeat)
             }
             Command::Check { scene, json } => check::check(&scene_path(&scene), json),
+            Command::Bsdf(args) => bsdf::bsdf(args),
         };
         done.map(|()| ExitCode::SUCCESS)
     }

@@ -11,6 +11,7 @@
 //! library.
 
 pub mod accel;
+pub mod characterise;
 pub mod color;
 pub mod count;
 pub mod detector;

@@ -12,6 +12,7 @@
 //! a guide) and [`spectrum`] (the light a photon carries and the quantities read at it).
 
 pub mod absorber;
+pub mod bsdf_table;
 pub mod density;
 pub mod dielectric;
 pub mod diffuser;

@@ -138,6 +138,8 @@ surface_models! {
     "mirror" => Mirror(Mirror, MirrorSpec),
     /// Black absorber ([`super::absorber`]).
     "absorber" => Absorber(Absorber, AbsorberSpec),
+    /// Measured BSDF table, IS BSDF format ([`super::bsdf_table`]).
+    "bsdf_table" => BsdfTable(super::bsdf_table::BsdfTable, super::bsdf_table::BsdfTableSpec),
 }
 
 impl SurfaceModel {

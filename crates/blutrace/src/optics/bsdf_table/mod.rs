@@ -1,0 +1,368 @@
+//! Measured BSDF tables: a face that scatters as an IS BSDF file (Zemax/Radiant BSDF Data
+//! Interchange format, [`format`]) says, as scatterometers measure films, sheets and inks
+//! and `blutrace bsdf` characterises a part of a scene.
+//!
+//! ```toml
+//! [surfaces.diffuser_film]
+//! model = "bsdf_table"
+//! file = "film.bsdf"       # or a list: file = ["film_r.bsdf", "film_t.bsdf"]
+//! inside = "air"           # with a BTDF: the medium behind the face (as dielectric's)
+//! outside = "air"          # default "air"
+//! u_axis = [1.0, 0.0, 0.0] # optional: the direction of sample rotation 0 on the face
+//! ```
+//!
+//! The files hold at most one BRDF and one BTDF section. A photon arriving at the
+//! angle of incidence `theta` (to the face's normal on its side, either side: the part is
+//! taken as the same seen from both) is reflected back into its medium with probability
+//! `TIS_R(theta)`, transmitted into the medium on the other side with probability
+//! `TIS_T(theta)` (a table with a BTDF is an interface and needs `inside`), else absorbed
+//! (analog roulette, or the weight `TIS_R + TIS_T` when absorption is weighted). The
+//! direction is drawn from the table ([`sample`]): exactly the BSDF times the cosine, as
+//! the cells give it; the TIS gives the power (the table's values, as other tracers read
+//! them, set the shape only).
+//!
+//! Between the table's angles of incidence the BSDF is interpolated linearly at each
+//! outgoing direction (one of the two neighbouring blocks is drawn with the weight of its
+//! share, and scatters as at its own AOI); outside them the nearest block is used. A
+//! sharp (glossy) peak therefore does not move between two AOIs but fades from one
+//! node's place to the next: such tables need a fine AOI grid. Sample rotations (the orientation of the plane of incidence on
+//! the face, measured from `u_axis` towards `normal x u_axis`) take the nearest block;
+//! `u_axis` defaults to the world x axis projected onto the face (the y axis where the
+//! face's normal is within 26 degrees of x). Monochrome tables only.
+//!
+//! What a table leaves out: where the light leaves (a part's lateral spread: light
+//! enters and leaves at one point), polarisation, coherence, and any difference between
+//! the part's two sides.
+
+pub mod format;
+pub mod sample;
+
+use super::medium::{Interface, Medium, air};
+use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+use crate::rng::PhotonRng;
+use crate::spec_check::Ctx;
+use anyhow::{Result, bail};
+use format::{ScatterType, Section};
+use glam::DVec3;
+use sample::{BlockSampler, Frame, Grid, Incidence};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// One file or several.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Files {
+    /// One file.
+    One(PathBuf),
+    /// Several files (e.g. a BRDF and a BTDF file).
+    Many(Vec<PathBuf>),
+}
+
+impl Files {
+    fn list(&self) -> Vec<PathBuf> {
+        match self {
+            Files::One(f) => vec![f.clone()],
+            Files::Many(v) => v.clone(),
+        }
+    }
+}
+
+/// `[surfaces.TAG]` with `model = "bsdf_table"`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BsdfTableSpec {
+    /// The IS BSDF file(s), relative to the scene file.
+    pub file: Files,
+    /// Medium behind the face (needed with a BTDF).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inside: Option<String>,
+    /// Medium in front of the face.
+    #[serde(default = "air")]
+    pub outside: String,
+    /// The direction of sample rotation 0 on the face.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub u_axis: Option<[f64; 3]>,
+}
+
+/// One scatter type's table, ready to sample.
+#[derive(Debug, PartialEq)]
+pub struct Table {
+    /// BRDF or BTDF.
+    pub kind: ScatterType,
+    /// Sample rotations (radians).
+    rotations: Vec<f64>,
+    /// Angles of incidence (radians).
+    aoi: Vec<f64>,
+    /// The cells.
+    grid: Grid,
+    /// Rotation-major blocks (`None`: TIS 0 and no values above the surface).
+    blocks: Vec<Option<BlockSampler>>,
+}
+
+impl Table {
+    /// Build the table of `sec`, read from `file` (named in errors).
+    pub fn new(sec: &Section, file: &Path) -> Result<Table> {
+        let grid = Grid::new(&sec.radial, &sec.azimuth, sec.plane_symmetric);
+        let aoi: Vec<f64> = sec.aoi.iter().map(|a| a.to_radians()).collect();
+        let mut blocks = Vec::with_capacity(sec.blocks.len());
+        for (k, b) in sec.blocks.iter().enumerate() {
+            let s = BlockSampler::new(&grid, aoi[k % aoi.len()], b.tis, &b.values);
+            if s.is_none() && b.tis > 0.0 {
+                bail!(
+                    "{}: line {}: TIS {} of the {} block at AOI {} deg, rotation {} deg, but no value of it lies above the surface",
+                    file.display(),
+                    b.line,
+                    b.tis,
+                    sec.scatter.keyword(),
+                    sec.aoi[k % aoi.len()],
+                    sec.rotations[k / aoi.len()]
+                );
+            }
+            blocks.push(s);
+        }
+        Ok(Table {
+            kind: sec.scatter,
+            rotations: sec.rotations.iter().map(|a| a.to_radians()).collect(),
+            aoi,
+            grid,
+            blocks,
+        })
+    }
+
+    /// The nearest sample rotation's index to `rot` (radians, periodic).
+    fn rotation(&self, rot: f64) -> usize {
+        let dist = |r: f64| {
+            let d = (r - rot).rem_euclid(TAU);
+            d.min(TAU - d)
+        };
+        (0..self.rotations.len())
+            .min_by(|&a, &b| dist(self.rotations[a]).total_cmp(&dist(self.rotations[b])))
+            .unwrap_or(0)
+    }
+
+    /// The two blocks about `theta` in rotation `ri` and the weight of the second.
+    fn bracket(&self, ri: usize, theta: f64) -> (usize, usize, f64) {
+        let n = self.aoi.len();
+        let base = ri * n;
+        let k = self.aoi.partition_point(|&a| a <= theta);
+        if k == 0 {
+            (base, base, 0.0)
+        } else if k == n {
+            (base + n - 1, base + n - 1, 0.0)
+        } else {
+            let t = (theta - self.aoi[k - 1]) / (self.aoi[k] - self.aoi[k - 1]);
+            (base + k - 1, base + k, t)
+        }
+    }
+
+    fn tis_of(&self, k: usize) -> f64 {
+        self.blocks[k].as_ref().map_or(0.0, |b| b.tis)
+    }
+
+    /// The TIS at sample rotation `rot` and angle of incidence `theta` (radians).
+    pub fn tis(&self, rot: f64, theta: f64) -> f64 {
+        let (a, b, t) = self.bracket(self.rotation(rot), theta);
+        (1.0 - t) * self.tis_of(a) + t * self.tis_of(b)
+    }
+
+    /// A scattered direction for a photon meeting the face as `inc` says (`None`: the
+    /// table holds no scatter there): one of the two blocks about its AOI, drawn in
+    /// proportion to its share of the interpolated TIS, sampled in the frame of that
+    /// block's own AOI, so that the BSDF at each outgoing direction is interpolated
+    /// linearly in the angle of incidence.
+    pub fn sample(&self, inc: &Incidence, rng: &mut PhotonRng) -> Option<DVec3> {
+        let (a, b, t) = self.bracket(self.rotation(inc.rotation), inc.theta);
+        let (ta, tb) = ((1.0 - t) * self.tis_of(a), t * self.tis_of(b));
+        let k = if rng.uniform() * (ta + tb) < tb { b } else { a };
+        let own = self.aoi[k % self.aoi.len()];
+        let frame = Frame::new(self.kind, &inc.at_angle(own));
+        self.blocks[k].as_ref()?.sample(&self.grid, &frame, rng)
+    }
+}
+
+/// A face that scatters as measured tables say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BsdfTable {
+    /// The reflection table.
+    pub brdf: Option<Arc<Table>>,
+    /// The transmission table.
+    pub btdf: Option<Arc<Table>>,
+    /// The two media (with a BTDF; `None`: opaque).
+    pub interface: Option<Interface>,
+    /// The direction of sample rotation 0 (`None`: world x, or y on faces facing x).
+    pub u_axis: Option<DVec3>,
+}
+
+impl BsdfTable {
+    /// The unit tangent of sample rotation 0 on a face of unit normal `n`.
+    fn u_on(&self, n: DVec3) -> DVec3 {
+        let u = self
+            .u_axis
+            .unwrap_or(if n.x.abs() > 0.9 { DVec3::Y } else { DVec3::X });
+        (u - u.dot(n) * n).normalize()
+    }
+
+    /// The TIS of reflection and transmission for a photon of `inc`.
+    fn tis(&self, inc: &Incidence) -> (f64, f64) {
+        let of =
+            |t: &Option<Arc<Table>>| t.as_ref().map_or(0.0, |t| t.tis(inc.rotation, inc.theta));
+        (of(&self.brdf), of(&self.btdf))
+    }
+}
+
+impl Surface for BsdfTable {
+    fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
+        let n = at.facing();
+        let inc = sample::incidence(at.dir, n, self.u_on(n));
+        let (r, t) = self.tis(&inc);
+        let Some(weight) = at.est.survive(r + t, rng) else {
+            return (Outcome::Absorbed, Feature::Plain);
+        };
+        let reflect = rng.uniform() * (r + t) < r;
+        let (table, medium) = match (reflect, self.interface) {
+            (true, _) => (&self.brdf, at.medium),
+            (false, Some(i)) => {
+                let entering = at.dir.dot(at.hit.normal) < 0.0;
+                (&self.btdf, if entering { i.inside } else { i.outside })
+            }
+            (false, None) => return (Outcome::Absorbed, Feature::Plain),
+        };
+        let dir = table.as_ref().and_then(|tab| tab.sample(&inc, rng));
+        let out = match dir {
+            Some(dir) => Outcome::Scattered {
+                dir,
+                medium,
+                weight,
+            },
+            None => Outcome::Absorbed,
+        };
+        (out, Feature::Plain)
+    }
+
+    fn interface(&self) -> Option<Interface> {
+        self.interface
+    }
+
+    fn fit_to_face(&mut self, ctx: &Ctx, at: &str, face: &Face) -> Result<()> {
+        let Some(u) = self.u_axis else {
+            return Ok(());
+        };
+        if face.normals().any(|n| n.dot(u).abs() > 0.999) {
+            return Err(ctx.err(
+                &format!("{at}.u_axis"),
+                "is (nearly) along a normal of the face: it must lie in the face",
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl SurfaceSpecOf for BsdfTableSpec {
+    type Model = BsdfTable;
+
+    fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<BsdfTable> {
+        let dir = ctx.0.parent().unwrap_or(Path::new("."));
+        let field = format!("{at}.file");
+        let files = self.file.list();
+        if files.is_empty() {
+            return Err(ctx.err(&field, "names no file"));
+        }
+        let (brdf, btdf) = read_tables(ctx, &field, dir, &files)?;
+        check_sum(ctx, &field, brdf.as_ref(), btdf.as_ref())?;
+        let interface = match (&self.inside, &btdf) {
+            (Some(inside), _) => Some(Interface::build(ctx, at, inside, &self.outside, media)?),
+            (None, Some((p, _))) => {
+                return Err(ctx.err(
+                    &format!("{at}.inside"),
+                    format!(
+                        "{} has a BTDF: light crosses the face, so give the medium behind it (inside = \"...\")",
+                        p.display()
+                    ),
+                ));
+            }
+            (None, None) => None,
+        };
+        let u_axis = self
+            .u_axis
+            .map(|u| ctx.direction(&format!("{at}.u_axis"), u))
+            .transpose()?;
+        Ok(BsdfTable {
+            brdf: brdf.map(|b| b.1),
+            btdf: btdf.map(|b| b.1),
+            interface,
+            u_axis,
+        })
+    }
+
+    fn files(&self) -> Vec<PathBuf> {
+        self.file.list()
+    }
+}
+
+/// A table and the file it came from.
+type Loaded = Option<(PathBuf, Arc<Table>)>;
+
+/// Read `files` (relative to `dir`; `field` names them in errors): the BRDF and the BTDF.
+fn read_tables(ctx: &Ctx, field: &str, dir: &Path, files: &[PathBuf]) -> Result<(Loaded, Loaded)> {
+    let (mut brdf, mut btdf): (Loaded, Loaded) = (None, None);
+    for f in files {
+        let path = dir.join(f);
+        let text = crate::input_file::read_text(&path, "BSDF table")
+            .map_err(|e| ctx.err(field, format!("{e:#}")))?;
+        for sec in format::parse(&text, &path)? {
+            let slot = match sec.scatter {
+                ScatterType::Brdf => &mut brdf,
+                ScatterType::Btdf => &mut btdf,
+            };
+            if let Some((first, _)) = slot {
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "{} holds a second {} section (the first is in {}): give one of each at most",
+                        path.display(),
+                        sec.scatter.keyword(),
+                        first.display()
+                    ),
+                ));
+            }
+            *slot = Some((path.clone(), Arc::new(Table::new(&sec, &path)?)));
+        }
+    }
+    Ok((brdf, btdf))
+}
+
+/// The reflected and transmitted TIS may not add up to more than 1 at any of either
+/// table's (rotation, AOI) nodes.
+fn check_sum(
+    ctx: &Ctx,
+    field: &str,
+    brdf: Option<&(PathBuf, Arc<Table>)>,
+    btdf: Option<&(PathBuf, Arc<Table>)>,
+) -> Result<()> {
+    let (Some((pr, r)), Some((pt, t))) = (brdf, btdf) else {
+        return Ok(());
+    };
+    for tab in [r, t] {
+        for &rot in &tab.rotations {
+            for &aoi in &tab.aoi {
+                let (a, b) = (r.tis(rot, aoi), t.tis(rot, aoi));
+                if a + b > 1.0 + 1e-9 {
+                    return Err(ctx.err(
+                        field,
+                        format!(
+                            "at AOI {} deg, rotation {} deg the BRDF's TIS {a} ({}) and the BTDF's {b} ({}) add up to {}, more than 1",
+                            aoi.to_degrees(),
+                            rot.to_degrees(),
+                            pr.display(),
+                            pt.display(),
+                            a + b
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}

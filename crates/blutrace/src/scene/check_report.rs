@@ -5,6 +5,7 @@
 use super::Scene;
 use crate::optics::medium::Medium;
 use crate::optics::two_sided;
+use crate::sources::Emitter;
 use anyhow::Result;
 use std::path::Path;
 
@@ -22,6 +23,11 @@ pub fn check_json(scene: &Scene, scene_file: &Path) -> Result<serde_json::Value>
             "power_w": s.power_w,
             "medium": scene.media[s.medium as usize].name,
             "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
+            "spectrum_efficacy_lm_per_w": s.spectrum.as_ref().map(|sp| sp.efficacy_lm_per_w()),
+            "rayfile": match &s.emitter {
+                Emitter::RayFile(r) => serde_json::to_value(r.summary()).ok(),
+                _ => None,
+            },
         })).collect::<Vec<_>>(),
         "surfaces": surfaces_json(scene),
         "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),

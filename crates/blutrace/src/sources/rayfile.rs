@@ -41,7 +41,7 @@ mod emitter;
 pub mod text;
 pub mod tm25;
 
-pub use emitter::{Alias, RayFileEmitter};
+pub use emitter::{Alias, RayFileEmitter, RayFileSummary};
 
 use super::array::ArraySpec;
 use super::body::BodySpec;

@@ -167,3 +167,63 @@ impl RayFileEmitter {
         })
     }
 }
+
+/// What `check` shows of a ray file source.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RayFileSummary {
+    /// The file as the scene names it.
+    pub file: String,
+    /// Its non-empty TM-25 text fields, by name.
+    pub text: Vec<(String, String)>,
+    /// Number of rays.
+    pub rays: usize,
+    /// Total flux of the rays and its unit ("W" or "lm").
+    pub total_flux: f64,
+    /// "W" or "lm".
+    pub flux_unit: &'static str,
+    /// The start points' bounds in the file's frame (file units) and in the scene (mm).
+    pub bounds_file: [[f64; 3]; 2],
+    /// The placed bounds (mm).
+    pub bounds_scene_mm: [[f64; 3]; 2],
+    /// What the file says of wavelengths.
+    pub spectrum: String,
+}
+
+impl RayFileEmitter {
+    /// The summary `check` prints.
+    pub fn summary(&self) -> RayFileSummary {
+        let s = &self.set;
+        let text = super::TEXT_FIELD_NAMES
+            .iter()
+            .zip(&s.text)
+            .filter(|(_, t)| !t.is_empty())
+            .map(|(n, t)| (n.to_string(), t.clone()))
+            .collect();
+        let (lo, hi) = s.bounds();
+        let (slo, shi) = self.scene_bounds();
+        let range = s
+            .wavelength_range()
+            .map_or(String::new(), |(a, b)| format!(", {a}-{b} nm"));
+        let spectrum = match &s.spectrum {
+            FileSpectrum::None => "none (monochrome unless the entry gives spectrum)".to_string(),
+            FileSpectrum::Single(nm) => format!("one wavelength, {nm} nm"),
+            FileSpectrum::PerRay => format!("a wavelength per ray{range}"),
+            FileSpectrum::Table(rows) => {
+                format!("one table of {} rows for every ray{range}", rows.len())
+            }
+        };
+        RayFileSummary {
+            file: self.file.display().to_string(),
+            text,
+            rays: s.rays.len(),
+            total_flux: s.total_flux(),
+            flux_unit: match s.unit {
+                super::FluxUnit::Watt => "W",
+                super::FluxUnit::Lumen => "lm",
+            },
+            bounds_file: [lo.to_array(), hi.to_array()],
+            bounds_scene_mm: [slo.to_array(), shi.to_array()],
+            spectrum,
+        }
+    }
+}

@@ -146,7 +146,7 @@ fn a_ray_file_of_the_led_model_traces_like_it() {
 }
 
 #[test]
-#[ignore = "slow statistical test (about a minute on 2 cores)"]
+#[ignore = "slow statistical test (about 20 s on 2 idle cores)"]
 fn a_ray_file_of_the_led_model_traces_like_it_at_1m_photons() {
     led_and_ray_file_agree(1_000_000, 1_000_000);
 }

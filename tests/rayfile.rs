@@ -151,8 +151,8 @@ fn a_ray_file_of_the_led_model_traces_like_it_at_1m_photons() {
     led_and_ray_file_agree(1_000_000, 1_000_000);
 }
 
-/// Two rays straight down onto a mirror that reflects only beyond 550 nm, back up to the
-/// target: what is detected is the 650 nm ray's share of the photons.
+/// A mirror below (z = -1) that reflects only beyond 550 nm, the target above (z = 1), and
+/// a ray file `rays` (text) in between.
 fn two_colour_scene(name: &str, rays: &str, extra: &str) -> Scene {
     let mirror = "v -5 -5 -1\nv 5 -5 -1\nv 5 5 -1\nv -5 5 -1\nusemtl mirror\nf 1 2 3\nf 1 3 4\n";
     let toml = format!(
@@ -170,7 +170,8 @@ fn two_colour_scene(name: &str, rays: &str, extra: &str) -> Scene {
 
 #[test]
 fn wavelengths_and_flux_weights_reach_the_photons() {
-    let rays = "# x y z kx ky kz flux nm\n0 0 0  0 0 -1  0.25 450\n0.5 0 0  0 0 -1  0.75 650\n";
+    // 450 nm down onto the mirror (absorbed), 650 nm straight up to the target.
+    let rays = "# x y z kx ky kz flux nm\n0 0 0  0 0 -1  0.25 450\n0.5 0 0  0 0 1  0.75 650\n";
     let scene = two_colour_scene("two-colours", rays, "");
     let s = &scene.sources.list[0];
     assert_eq!(s.power_w, 1.0, "power_w defaults to the file's total flux");
@@ -185,8 +186,9 @@ fn wavelengths_and_flux_weights_reach_the_photons() {
         (detected - 0.75).abs() < 4.0 * se,
         "detected {detected}, expected 0.75 (the 650 nm flux share)"
     );
-    // Half the photons per ray (flux ignored) or every photon at 555 nm (wavelength
-    // ignored) would detect 0.5 or 1.
+    // Half the photons per ray (flux ignored) would detect 0.5; every photon at 555 nm
+    // (wavelengths ignored) 1; wavelengths drawn from the file's spectrum instead of
+    // going with their rays 0.75 + 0.25 x 0.75 = 0.9375.
 }
 
 #[test]
@@ -239,14 +241,14 @@ fn scene_two_sources(_rays: &str, extra: &str) -> String {
 
 #[test]
 fn a_ray_lands_where_its_placement_puts_it() {
-    let rays = "1 2 3  0 0 1  1.0\n";
+    let rays = "1 2 3  1 0 0  1.0\n";
     let extra = "units = \"cm\"\nrotate_deg = [0.0, 0.0, 90.0]\ntranslate = [100.0, 0.0, 0.0]\npower_w = 2.0\n";
     let scene = two_colour_scene("placed", rays, extra);
     let e = scene.sources.sample(&mut PhotonRng::new(1, 0));
     // (10, 20, 30) mm turned 90 degrees about z: (-20, 10, 30), then moved.
     let at = e.ray.origin + scene.offset; // the loader centres the scene
     assert!((at - DVec3::new(80.0, 10.0, 30.0)).length() < 1e-9, "{at}");
-    assert!((e.ray.dir - DVec3::Z).length() < 1e-12);
+    assert!((e.ray.dir - DVec3::Y).length() < 1e-12, "{}", e.ray.dir);
     assert_eq!(scene.sources.list[0].power_w, 2.0);
     let bad = "matrix = [[2.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]\n";
     let dir = temp_folder("rayfile-matrix");

@@ -80,6 +80,9 @@ fn error_after(edit: impl FnOnce(&mut Vec<u8>)) -> String {
     e
 }
 
+/// A change to a file's bytes.
+type Edit = Box<dyn FnOnce(&mut Vec<u8>)>;
+
 fn put_f32(b: &mut [u8], at: usize, x: f32) {
     b[at..at + 4].copy_from_slice(&x.to_le_bytes());
 }
@@ -87,7 +90,7 @@ fn put_f32(b: &mut [u8], at: usize, x: f32) {
 #[test]
 fn tm25_errors_name_the_byte_and_the_field() {
     let ray0 = 36288;
-    let cases: Vec<(Box<dyn FnOnce(&mut Vec<u8>)>, &str)> = vec![
+    let cases: Vec<(Edit, &str)> = vec![
         (
             Box::new(|b| b.truncate(b.len() - 1)),
             "byte 20: number of rays (4.7.1.6): 3 rays of 32 bytes",

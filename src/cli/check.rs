@@ -7,6 +7,8 @@ use blutrace::optics::medium::Medium;
 use blutrace::optics::two_sided;
 use blutrace::scene::Scene;
 use blutrace::scene::geometry_report::BoxMm;
+use blutrace::sources::rayfile::RayFileSummary;
+use blutrace::sources::spectrum::EmissionSpectrum;
 use std::path::Path;
 
 /// "  x from .. to .. mm" for a check line.
@@ -58,6 +60,28 @@ fn scattering(m: &Medium) -> String {
         s.anisotropy,
         s.reduced_per_mm()
     )
+}
+
+/// The lines `check` prints under a ray file source: its text fields, rays, flux, bounds
+/// and spectrum.
+fn rayfile_lines(r: &RayFileSummary, spectrum: Option<&EmissionSpectrum>) {
+    say!(
+        "  ray file {}: {} rays, total {:.6} {}",
+        r.file,
+        r.rays,
+        r.total_flux,
+        r.flux_unit
+    );
+    for (name, text) in &r.text {
+        say!("    {name:<23} {text}");
+    }
+    let b = |x: [[f64; 3]; 2]| format!("from {:.4?} to {:.4?}", x[0], x[1]);
+    say!("    start points (file) {}", b(r.bounds_file));
+    say!("    start points (mm)   {}", b(r.bounds_scene_mm));
+    let efficacy = spectrum.map_or(String::new(), |s| {
+        format!("; {:.1} lm/W", s.efficacy_lm_per_w())
+    });
+    say!("    wavelengths         {}{efficacy}", r.spectrum);
 }
 
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {
@@ -143,7 +167,9 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             s.name,
             s.power_w
         );
-        if let Some(sp) = &s.spectrum {
+        if let blutrace::sources::Emitter::RayFile(r) = &s.emitter {
+            rayfile_lines(&r.summary(), s.spectrum.as_deref());
+        } else if let Some(sp) = &s.spectrum {
             say!("           {:<20} {}", "", sp.describe());
         }
     }

@@ -1,12 +1,13 @@
 //! Light sources, sampled in proportion to power: one module per source type with its
 //! scene-file entry, its checks and its emission ([`ccfl`]: a Lambertian tube; [`led`]: a
-//! flat emitter, cos^m or a measured table from [`intensity`]), and what every source
+//! flat emitter, cos^m or a measured table from [`intensity`]; [`rayfile`]: rays from a
+//! TM-25 or text ray file), and what every source
 //! has besides: a name, its power, the medium it emits into, an optional lamp body
 //! ([`body`], shaped by [`body_shape`]) and a row of copies ([`mod@array`]).
 //!
 //! ```toml
 //! [[sources]]
-//! type = "ccfl"              # or "led"; the type's own keys: see `ccfl`, `led`
+//! type = "ccfl"              # or "led", "rayfile"; the type's own keys: see `ccfl`, `led`, `rayfile`
 //! name = "left_upper"        # for reports (default: the type and the entry's index)
 //! power_w = 1.0              # radiant power (W)
 //! lumens = 300.0             # optional: luminous flux, for luminance outputs
@@ -22,6 +23,7 @@ pub mod body_shape;
 pub mod ccfl;
 pub mod intensity;
 pub mod led;
+pub mod rayfile;
 pub mod spectrum;
 
 use crate::geometry::Ray;
@@ -35,6 +37,7 @@ use body_shape::{BodyShape, Rect};
 use ccfl::{CcflSpec, Tube};
 use glam::DVec3;
 use led::{FlatLed, LedSpec};
+use rayfile::{RayFileEmitter, RayFileSpec};
 use serde::{Deserialize, Serialize};
 use spectrum::{EmissionSpectrum, SpectrumSpec};
 use std::path::PathBuf;
@@ -48,12 +51,14 @@ pub enum SourceSpec {
     Ccfl(CcflSpec),
     /// Flat LED emitter ([`led`]).
     Led(LedSpec),
+    /// Rays from a TM-25 or text ray file ([`rayfile`]).
+    Rayfile(RayFileSpec),
 }
 
 /// What every source entry gives besides its emitting shape.
 struct Common<'a> {
     name: &'a Option<String>,
-    power_w: f64,
+    power_w: Option<f64>,
     lumens: Option<f64>,
     spectrum: Option<&'a SpectrumSpec>,
     medium: &'a str,
@@ -67,6 +72,7 @@ impl SourceSpec {
         match self {
             SourceSpec::Ccfl(s) => s.array.as_ref(),
             SourceSpec::Led(s) => s.array.as_ref(),
+            SourceSpec::Rayfile(s) => s.array.as_ref(),
         }
     }
 
@@ -76,6 +82,7 @@ impl SourceSpec {
         let mut files: Vec<PathBuf> = match self {
             SourceSpec::Led(s) => s.intensity_file.iter().cloned().collect(),
             SourceSpec::Ccfl(_) => Vec::new(),
+            SourceSpec::Rayfile(s) => return s.files(),
         };
         let spectrum = self.common().spectrum.and_then(SpectrumSpec::file);
         files.extend(spectrum.map(PathBuf::from));
@@ -87,6 +94,7 @@ impl SourceSpec {
         match self {
             SourceSpec::Ccfl(_) => "ccfl",
             SourceSpec::Led(_) => "led",
+            SourceSpec::Rayfile(_) => "rayfile",
         }
     }
 
@@ -94,7 +102,7 @@ impl SourceSpec {
         match self {
             SourceSpec::Ccfl(s) => Common {
                 name: &s.name,
-                power_w: s.power_w,
+                power_w: Some(s.power_w),
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
                 medium: &s.medium,
@@ -102,6 +110,15 @@ impl SourceSpec {
                 package_depth_mm: None,
             },
             SourceSpec::Led(s) => Common {
+                name: &s.name,
+                power_w: Some(s.power_w),
+                lumens: s.lumens,
+                spectrum: s.spectrum.as_ref(),
+                medium: &s.medium,
+                body: &s.body,
+                package_depth_mm: s.package_depth_mm,
+            },
+            SourceSpec::Rayfile(s) => Common {
                 name: &s.name,
                 power_w: s.power_w,
                 lumens: s.lumens,
@@ -122,15 +139,23 @@ impl SourceSpec {
         let emitter = match self {
             SourceSpec::Ccfl(s) => Emitter::Ccfl(s.tube(ctx, &at)?),
             SourceSpec::Led(s) => Emitter::Led(s.led(ctx, &at)?),
+            SourceSpec::Rayfile(s) => Emitter::RayFile(s.emitter(ctx, &at)?),
         };
         let depth = common
             .package_depth_mm
             .map(|d| ctx.length(&f("package_depth_mm"), d))
             .transpose()?;
-        let spectrum = common
-            .spectrum
-            .map(|s| s.build(ctx, &f("spectrum")))
-            .transpose()?;
+        let spectrum = match (common.spectrum, emitter.own_spectrum()) {
+            (Some(_), Some(_)) => {
+                return Err(ctx.err(
+                    &f("spectrum"),
+                    "the ray file gives the rays' wavelengths: remove spectrum",
+                ));
+            }
+            (Some(s), None) => Some(s.build(ctx, &f("spectrum"))?),
+            (None, Some(own)) => Some(own.map_err(|e| ctx.err(&f("file"), e))?),
+            (None, None) => None,
+        };
         if spectrum.is_some() && common.lumens.is_some() {
             return Err(ctx.err(
                 &f("lumens"),
@@ -146,7 +171,15 @@ impl SourceSpec {
                 Some(n) => ctx.name(&f("name"), n)?.to_owned(),
                 None => format!("{}{i}", self.kind()),
             },
-            power_w: ctx.positive(&f("power_w"), common.power_w)?,
+            power_w: match common.power_w {
+                Some(p) => ctx.positive(&f("power_w"), p)?,
+                None => emitter.file_power_w().ok_or_else(|| {
+                    ctx.err(
+                        &f("power_w"),
+                        "missing: the ray file gives luminous flux only",
+                    )
+                })?,
+            },
             lumens: ctx.optional_positive(&f("lumens"), common.lumens)?,
             spectrum: spectrum.map(Arc::new),
             emitter,
@@ -163,14 +196,49 @@ pub enum Emitter {
     Ccfl(Tube),
     /// A flat rectangle, cos^m or a measured profile (an LED die or window).
     Led(FlatLed),
+    /// Rays from a ray file, drawn in proportion to flux.
+    RayFile(RayFileEmitter),
 }
 
 impl Emitter {
     /// A photon leaving the emitter: its ray and the emitting surface's normal.
     pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3) {
+        let (ray, normal, _) = self.emit_nm(rng);
+        (ray, normal)
+    }
+
+    /// [`Emitter::emit`], with the photon's own wavelength (nm) when the emitter gives
+    /// one (a ray file's ray), else `None` (the source's spectrum, if any, draws it).
+    pub fn emit_nm(&self, rng: &mut PhotonRng) -> (Ray, DVec3, Option<f64>) {
         match self {
-            Emitter::Ccfl(t) => t.emit(rng),
-            Emitter::Led(l) => l.emit(rng),
+            Emitter::Ccfl(t) => {
+                let (ray, n) = t.emit(rng);
+                (ray, n, None)
+            }
+            Emitter::Led(l) => {
+                let (ray, n) = l.emit(rng);
+                (ray, n, None)
+            }
+            Emitter::RayFile(r) => r.emit(rng),
+        }
+    }
+
+    /// The spectrum the emitter itself gives (a ray file's table or wavelengths; `Err`:
+    /// they have no power within 360-830 nm).
+    fn own_spectrum(&self) -> Option<Result<EmissionSpectrum>> {
+        match self {
+            Emitter::RayFile(r) => r.set.emission_spectrum(),
+            Emitter::Ccfl(_) | Emitter::Led(_) => None,
+        }
+    }
+
+    /// The radiant power the emitter itself gives (a ray file's total radiant flux).
+    fn file_power_w(&self) -> Option<f64> {
+        match self {
+            Emitter::RayFile(r) if r.set.unit == rayfile::FluxUnit::Watt => {
+                Some(r.set.total_flux())
+            }
+            _ => None,
         }
     }
 
@@ -179,6 +247,7 @@ impl Emitter {
         match self {
             Emitter::Ccfl(t) => t.center,
             Emitter::Led(l) => l.center,
+            Emitter::RayFile(r) => r.front.center,
         }
     }
 
@@ -186,6 +255,7 @@ impl Emitter {
         match self {
             Emitter::Ccfl(t) => t.center += d,
             Emitter::Led(l) => l.center += d,
+            Emitter::RayFile(r) => r.translate(d),
         }
     }
 
@@ -199,6 +269,7 @@ impl Emitter {
                 out.push(match self {
                     Emitter::Ccfl(t) => t.surface_point(f(i), f(j)),
                     Emitter::Led(l) => l.surface_point(f(i), f(j)),
+                    Emitter::RayFile(r) => r.window().surface_point(f(i), f(j)),
                 });
             }
         }
@@ -211,6 +282,7 @@ impl Emitter {
         match self {
             Emitter::Ccfl(t) => t.shape(),
             Emitter::Led(l) => l.shape(),
+            Emitter::RayFile(r) => r.shape(),
         }
     }
 
@@ -220,6 +292,7 @@ impl Emitter {
         match self {
             Emitter::Ccfl(t) => t.distance(p),
             Emitter::Led(l) => l.distance(p),
+            Emitter::RayFile(r) => r.window().distance(p),
         }
     }
 
@@ -228,15 +301,16 @@ impl Emitter {
     pub fn copies_overlap(&self, d: DVec3, pitch: f64) -> Option<String> {
         match self {
             Emitter::Ccfl(t) => t.copies_overlap(d, pitch),
-            Emitter::Led(_) => None,
+            Emitter::Led(_) | Emitter::RayFile(_) => None,
         }
     }
 
-    /// An LED's emitting rectangle (`None` for a CCFL).
+    /// An LED's emitting rectangle, or a ray file's front (`None` for a CCFL).
     pub fn rect(&self) -> Option<Rect> {
         match self {
             Emitter::Ccfl(_) => None,
             Emitter::Led(l) => Some(l.rect()),
+            Emitter::RayFile(r) => Some(r.front),
         }
     }
 }
@@ -358,7 +432,7 @@ impl Sources {
                 format!("total power_w {total:e} W exceeds {MAX_TOTAL_POWER_W:e} W"),
             ));
         }
-        check_spectra(ctx, specs)?;
+        check_spectra(ctx, &list, &entry)?;
         Ok(Self::new(list))
     }
 
@@ -392,10 +466,11 @@ impl Sources {
             .partition_point(|&c| c <= u)
             .min(self.list.len() - 1);
         let s = &self.list[i];
-        let (ray, normal) = s.emit(rng);
-        let light = match &s.spectrum {
-            Some(sp) => Light::at_nm(sp.sample(rng.uniform())),
-            None => Light::MONOCHROME,
+        let (ray, normal, own_nm) = s.emitter.emit_nm(rng);
+        let light = match (own_nm, &s.spectrum) {
+            (Some(nm), _) => Light::at_nm(nm),
+            (None, Some(sp)) => Light::at_nm(sp.sample(rng.uniform())),
+            (None, None) => Light::MONOCHROME,
         };
         Emission {
             ray,
@@ -415,19 +490,20 @@ impl Sources {
     }
 }
 
-/// Either every source has a spectrum or none has: a photon of a monochrome source has no
-/// colour to add to a spectral one's.
-fn check_spectra(ctx: &Ctx, specs: &[SourceSpec]) -> Result<()> {
-    let has = |s: &SourceSpec| s.common().spectrum.is_some();
-    let (Some(with), Some(without)) = (
-        specs.iter().position(has),
-        specs.iter().position(|s| !has(s)),
-    ) else {
+/// Either every source has a spectrum (its `spectrum` key, or a ray file's wavelengths)
+/// or none has: a photon of a monochrome source has no colour to add to a spectral one's.
+/// `entry[k]` is the `[[sources]]` entry of source `k`.
+fn check_spectra(ctx: &Ctx, list: &[Source], entry: &[usize]) -> Result<()> {
+    let has = |s: &Source| s.spectrum.is_some();
+    let (Some(with), Some(without)) =
+        (list.iter().position(has), list.iter().position(|s| !has(s)))
+    else {
         return Ok(());
     };
+    let (with, without) = (entry[with], entry[without]);
     Err(ctx.err(
         &format!("sources[{without}].spectrum"),
-        format!("missing: sources[{with}] has a spectrum, so every source needs one (a monochrome source has no colour to add)"),
+        format!("missing: sources[{with}] has a spectrum (or a ray file with wavelengths), so every source needs one (a monochrome source has no colour to add)"),
     ))
 }
 

@@ -1,5 +1,6 @@
-//! Colorimetry: CIE tables, tabulated spectra and the colour of light (issue 33's foundation;
-//! not yet used by the tracer, whose home of wavelength is [`crate::optics::spectrum`]).
+//! Colorimetry: CIE tables, tabulated spectra and the colour of light (the tracer's home of
+//! wavelength is [`crate::optics::spectrum`]; sources draw from these spectra in
+//! [`crate::sources::spectrum`], the detector scores X, Y, Z in [`crate::tally::color`]).
 //!
 //! Conventions, as colour-science (`colour.colorimetry`) and CIE 015:2018 (Colorimetry, 4th
 //! ed., DOI 10.25039/TR.015.2018) have them:

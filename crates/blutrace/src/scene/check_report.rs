@@ -5,6 +5,7 @@
 use super::Scene;
 use crate::optics::medium::Medium;
 use crate::optics::two_sided;
+use crate::sources::Emitter;
 use anyhow::Result;
 use std::path::Path;
 
@@ -23,6 +24,10 @@ pub fn check_json(scene: &Scene, scene_file: &Path) -> Result<serde_json::Value>
             "medium": scene.media[s.medium as usize].name,
             "body": s.body.as_ref().map_or("transparent".to_string(), |b| b.describe()),
             "spectrum": s.spectrum.as_ref().map(|sp| sp.report()),
+            "rayfile": match &s.emitter {
+                Emitter::RayFile(r) => serde_json::to_value(r.summary()).ok(),
+                _ => None,
+            },
         })).collect::<Vec<_>>(),
         "surfaces": surfaces_json(scene),
         "media": scene.media.iter().map(medium_json).collect::<Vec<_>>(),

@@ -150,7 +150,7 @@ impl GeometrySpec {
             }
             (Some(r), None) => {
                 let r = ctx.angles_deg(&field("rotate_deg"), r)?;
-                DMat4::from_mat3(rotation_z(r.z) * rotation_y(r.y) * rotation_x(r.x))
+                DMat4::from_mat3(rotation_deg(r))
             }
             (None, Some(m)) => checked_matrix(ctx, &field("matrix"), m, warnings)?,
             (None, None) => DMat4::IDENTITY,
@@ -267,6 +267,12 @@ fn sin_cos_deg(a: f64) -> (f64, f64) {
         return SC[(quarter.round() as i64).rem_euclid(4) as usize];
     }
     a.to_radians().sin_cos()
+}
+
+/// The rotation by `r` degrees about x, then y, then z (right-handed; exact at multiples
+/// of 90 degrees): what `rotate_deg` means for geometry files and ray files alike.
+pub fn rotation_deg(r: DVec3) -> DMat3 {
+    rotation_z(r.z) * rotation_y(r.y) * rotation_x(r.x)
 }
 
 fn rotation_x(deg: f64) -> DMat3 {

@@ -238,8 +238,10 @@ fn cuts_emitter(e: &Emitter, c: [DVec3; 3], eps: f64) -> bool {
             let along = rel.dot(t.axis);
             along.abs() < t.length / 2.0 - eps && (rel - t.axis * along).length() < t.radius - eps
         }),
-        Emitter::Led(led) => {
-            let r = led.rect();
+        Emitter::Led(_) | Emitter::RayFile(_) => {
+            let Some(r) = e.rect() else {
+                return false;
+            };
             let plane = Plane {
                 origin: r.center,
                 u: r.u,

@@ -1,0 +1,570 @@
+//! IES TM-25-13 binary ray files (`.TM25RAY`): reader and writer.
+//!
+//! ```toml
+//! [[sources]]
+//! type = "rayfile"
+//! file = "led.TM25RAY"   # read here; every error names the byte offset and the field
+//! ```
+//!
+//! The layout (little-endian; section numbers of TM-25-13 §4.7, as the public domain
+//! reference implementation JuliusMuschaweck/TM25RaySetTools names its fields):
+//!
+//! | offset | bytes | field |
+//! |---|---|---|
+//! | 0 | 4 | file type `TM25` (4.7.1.1) |
+//! | 4 | i32 | version, 2013 (4.7.1.2) |
+//! | 8 | i32 | creation method (4.7.1.3, ignored) |
+//! | 12, 16 | f32 | total luminous (lm) and radiant (W) flux (4.7.1.4-5, reported) |
+//! | 20 | u64 | number of rays (4.7.1.6) |
+//! | 28 | 28 | creation date and time, ASCII (4.7.1.7, ignored) |
+//! | 56 | i32 | ray start position (4.7.1.8, ignored) |
+//! | 60 | i32 | spectral data identifier 0..4 (4.7.1.9) |
+//! | 64, 68, 72 | f32 | single, minimum, maximum wavelength, nm (4.7.1.10-12) |
+//! | 76, 80, 84 | i32 | spectral tables, additional ray items, additional text bytes |
+//! | 88 | 168 | reserved |
+//! | 256 | 8 x i32 | known data flags (4.7.2): position, direction, radiant flux, wavelength, luminous flux, Stokes, tristimulus, spectrum index |
+//! | 288 | 9 x 4000 | nine UTF-32 text fields of 1000 code points, NUL-padded (4.7.3) |
+//! | 36288 | | spectral tables (4.7.4): i32 count, then (f32 nm, f32 value) pairs; the block is zero-padded to a multiple of 32 bytes |
+//! | | 512 each | names of the additional ray items, UTF-32 (4.7.5) |
+//! | | | additional text, UTF-32 (4.7.6) |
+//! | | | ray records: f32 columns x y z kx ky kz, then radiant flux, wavelength, luminous flux, Stokes S1 S2 S3 and the polarisation ellipse's x y z, tristimulus X Z, spectrum index, additional items, each only when its flag is set |
+//!
+//! The ray count must fill the file exactly (a truncated file or a lying header is an
+//! error naming both lengths). Rays are read in one pass, in chunks, straight into the
+//! compact [`RaySet`]; the file is never held whole in memory.
+
+use super::{FileSpectrum, FluxUnit, RaySet, StoredRay, TEXT_FIELDS, check_ray, checked_len};
+use anyhow::{Result, bail};
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::Path;
+
+/// Bytes of the file header block (4.7.1).
+const HEADER_BYTES: usize = 256;
+/// Bytes of one text field (1000 UTF-32 code points).
+const TEXT_BYTES: usize = 4000;
+/// Where the spectral tables start: header, flags, nine text fields.
+const TABLES_AT: u64 = (HEADER_BYTES + 32 + 9 * TEXT_BYTES) as u64;
+/// Bytes of one additional item's name.
+const COLUMN_NAME_BYTES: u64 = 512;
+/// Rays read per chunk.
+const CHUNK_RAYS: usize = 1 << 16;
+
+/// Names of the known data flags (4.7.2.1 to 4.7.2.8).
+const FLAG_NAMES: [&str; 8] = [
+    "position",
+    "direction",
+    "radiant flux",
+    "wavelength",
+    "luminous flux",
+    "Stokes",
+    "tristimulus",
+    "spectrum index",
+];
+
+/// An error at byte `at` of `path`, in `field`.
+fn bad(path: &Path, at: u64, field: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{}: byte {at}: {field}: {msg}", path.display())
+}
+
+fn i32_at(b: &[u8], at: usize) -> i32 {
+    i32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+
+fn f32_at(b: &[u8], at: usize) -> f32 {
+    f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+
+/// The header fields the reader uses.
+struct Header {
+    rays: u64,
+    flags: [bool; 8],
+    identifier: i32,
+    single_nm: f32,
+    tables: i32,
+    extra_items: i32,
+    extra_text: i32,
+    luminous_lm: f32,
+    radiant_w: f32,
+}
+
+impl Header {
+    /// f32 columns per ray record.
+    fn columns(&self) -> u64 {
+        let f = |k: usize| self.flags[k] as u64;
+        6 + f(2) + f(3) + f(4) + 6 * f(5) + 2 * f(6) + f(7) + self.extra_items as u64
+    }
+}
+
+/// Read the file header and known data flags (the first 288 bytes), checked.
+fn header(path: &Path, b: &[u8]) -> Result<Header> {
+    if &b[0..4] != b"TM25" {
+        return Err(bad(
+            path,
+            0,
+            "file type (4.7.1.1)",
+            format!(
+                "expected \"TM25\", got {:?}",
+                String::from_utf8_lossy(&b[0..4])
+            ),
+        ));
+    }
+    let version = i32_at(b, 4);
+    if version != 2013 {
+        return Err(bad(
+            path,
+            4,
+            "version (4.7.1.2)",
+            format!("only TM-25-13 (2013) is read, got {version}"),
+        ));
+    }
+    let rays = u64::from_le_bytes(b[20..28].try_into().expect("8 bytes"));
+    let identifier = i32_at(b, 60);
+    let mut flags = [false; 8];
+    for (k, flag) in flags.iter_mut().enumerate() {
+        let at = HEADER_BYTES + 4 * k;
+        *flag = match i32_at(b, at) {
+            0 => false,
+            1 => true,
+            v => {
+                return Err(bad(
+                    path,
+                    at as u64,
+                    &format!("{} flag (4.7.2.{})", FLAG_NAMES[k], k + 1),
+                    format!("must be 0 or 1, got {v}"),
+                ));
+            }
+        };
+    }
+    let h = Header {
+        rays,
+        flags,
+        identifier,
+        single_nm: f32_at(b, 64),
+        tables: i32_at(b, 76),
+        extra_items: i32_at(b, 80),
+        extra_text: i32_at(b, 84),
+        luminous_lm: f32_at(b, 12),
+        radiant_w: f32_at(b, 16),
+    };
+    check_header(path, &h)?;
+    Ok(h)
+}
+
+/// The consistency rules of TM-25-13 between the header and the flags.
+fn check_header(path: &Path, h: &Header) -> Result<()> {
+    let flag = |k: usize, why: &str| {
+        bad(
+            path,
+            (HEADER_BYTES + 4 * k) as u64,
+            &format!("{} flag (4.7.2.{})", FLAG_NAMES[k], k + 1),
+            why,
+        )
+    };
+    if !h.flags[0] || !h.flags[1] {
+        let k = if h.flags[0] { 1 } else { 0 };
+        return Err(flag(
+            k,
+            "must be 1 (every ray has a position and a direction)",
+        ));
+    }
+    if !h.flags[2] && !h.flags[4] {
+        return Err(flag(
+            2,
+            "the radiant and luminous flux flags are both 0: the rays carry no flux",
+        ));
+    }
+    if !(0..=4).contains(&h.identifier) {
+        return Err(bad(
+            path,
+            60,
+            "spectral data identifier (4.7.1.9)",
+            format!("must be 0..4, got {}", h.identifier),
+        ));
+    }
+    if h.identifier == 4 || h.flags[7] {
+        return Err(bad(
+            path,
+            60,
+            "spectral data identifier (4.7.1.9)",
+            "per-ray spectral tables (identifier 4, spectrum index column) are not supported",
+        ));
+    }
+    if h.identifier == 2 && !h.flags[3] {
+        return Err(flag(
+            3,
+            "must be 1 when the spectral data identifier is 2 (a wavelength per ray)",
+        ));
+    }
+    if h.identifier == 2 && !h.flags[2] {
+        return Err(flag(
+            2,
+            "must be 1 when the spectral data identifier is 2 (TM-25-13 4.7.2.5)",
+        ));
+    }
+    if h.identifier == 1 && !(h.single_nm.is_finite() && h.single_nm > 0.0) {
+        return Err(bad(
+            path,
+            64,
+            "single wavelength (4.7.1.10)",
+            format!(
+                "must be > 0 nm for spectral data identifier 1, got {}",
+                h.single_nm
+            ),
+        ));
+    }
+    if h.tables < 0 || (h.identifier == 3 && h.tables != 1) {
+        return Err(bad(
+            path,
+            76,
+            "number of spectral tables (4.7.1.13)",
+            format!(
+                "got {} (identifier {} needs {})",
+                h.tables,
+                h.identifier,
+                if h.identifier == 3 {
+                    "exactly 1"
+                } else {
+                    "0 or more"
+                }
+            ),
+        ));
+    }
+    if h.extra_items < 0 {
+        return Err(bad(
+            path,
+            80,
+            "number of additional ray items (4.7.1.14)",
+            format!("must be >= 0, got {}", h.extra_items),
+        ));
+    }
+    if h.extra_text < 0 || h.extra_text % 4 != 0 {
+        return Err(bad(
+            path,
+            84,
+            "additional text size (4.7.1.15)",
+            format!(
+                "must be a non-negative multiple of 4 bytes, got {}",
+                h.extra_text
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A NUL-padded UTF-32LE text field at byte `at` of `path`.
+fn utf32(path: &Path, b: &[u8], at: u64, field: &str) -> Result<String> {
+    let mut s = String::new();
+    for (k, c) in b.chunks_exact(4).enumerate() {
+        let code = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+        if code == 0 {
+            break;
+        }
+        let ch = char::from_u32(code).ok_or_else(|| {
+            bad(
+                path,
+                at + 4 * k as u64,
+                field,
+                format!("U+{code:X} is not a Unicode code point"),
+            )
+        })?;
+        s.push(ch);
+    }
+    Ok(s)
+}
+
+/// Reads `n` bytes at a known offset, with errors naming the offset and the field.
+struct Cursor<R> {
+    inner: R,
+    at: u64,
+    len: u64,
+}
+
+impl<R: Read> Cursor<R> {
+    fn take(&mut self, path: &Path, n: u64, field: &str) -> Result<Vec<u8>> {
+        if self.at + n > self.len {
+            return Err(bad(
+                path,
+                self.at,
+                field,
+                format!(
+                    "the file ends at byte {} (truncated): {n} bytes needed",
+                    self.len
+                ),
+            ));
+        }
+        let mut buf = vec![0u8; n as usize];
+        self.inner
+            .read_exact(&mut buf)
+            .map_err(|e| bad(path, self.at, field, e))?;
+        self.at += n;
+        Ok(buf)
+    }
+}
+
+/// Read the TM-25 file at `path` into a ray set.
+pub fn read(path: &Path) -> Result<RaySet> {
+    let len = checked_len(path)?;
+    let file = std::fs::File::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read ray file: {e}", path.display()))?;
+    let mut c = Cursor {
+        inner: BufReader::with_capacity(1 << 20, file),
+        at: 0,
+        len,
+    };
+    let head = c.take(path, TABLES_AT, "header (4.7.1 to 4.7.3)")?;
+    let h = header(path, &head)?;
+    let mut text: [String; TEXT_FIELDS] = Default::default();
+    for (k, t) in text.iter_mut().enumerate() {
+        let at = HEADER_BYTES + 32 + k * TEXT_BYTES;
+        *t = utf32(
+            path,
+            &head[at..at + TEXT_BYTES],
+            at as u64,
+            &format!("text field 4.7.3.{}", k + 1),
+        )?;
+    }
+    let table = read_tables(path, &mut c, &h)?;
+    c.take(
+        path,
+        h.extra_items as u64 * COLUMN_NAME_BYTES,
+        "additional item names (4.7.5)",
+    )?;
+    c.take(path, h.extra_text as u64, "additional text (4.7.6)")?;
+    let record = 4 * h.columns();
+    let expected = h.rays.checked_mul(record).and_then(|r| r.checked_add(c.at));
+    if expected != Some(c.len) {
+        return Err(bad(
+            path,
+            20,
+            "number of rays (4.7.1.6)",
+            format!(
+                "{} rays of {record} bytes from byte {} need {} bytes, the file has {}",
+                h.rays,
+                c.at,
+                expected.map_or("more than 2^64".into(), |e| e.to_string()),
+                c.len
+            ),
+        ));
+    }
+    if h.rays == 0 {
+        return Err(bad(
+            path,
+            20,
+            "number of rays (4.7.1.6)",
+            "the file holds no rays",
+        ));
+    }
+    let spectrum = match h.identifier {
+        1 => FileSpectrum::Single(h.single_nm as f64),
+        2 => FileSpectrum::PerRay,
+        3 => FileSpectrum::Table(table.expect("identifier 3 has one table")),
+        _ => FileSpectrum::None,
+    };
+    let (rays, nm) = read_rays(path, &mut c, &h, matches!(spectrum, FileSpectrum::PerRay))?;
+    Ok(RaySet {
+        text,
+        rays,
+        nm,
+        spectrum,
+        unit: if h.flags[2] {
+            FluxUnit::Watt
+        } else {
+            FluxUnit::Lumen
+        },
+        header_flux: [h.radiant_w as f64, h.luminous_lm as f64],
+    })
+}
+
+/// The spectral tables block: the first table's rows (the only one identifier 3 uses).
+fn read_tables<R: Read>(
+    path: &Path,
+    c: &mut Cursor<R>,
+    h: &Header,
+) -> Result<Option<Vec<[f64; 2]>>> {
+    let start = c.at;
+    let mut first = None;
+    for t in 0..h.tables {
+        let field = format!("spectral table {} (4.7.4)", t + 1);
+        let n = i32_at(&c.take(path, 4, &field)?, 0);
+        if n <= 0 || n as u64 * 8 > c.len - c.at {
+            return Err(bad(
+                path,
+                c.at - 4,
+                &field,
+                format!("{n} rows: must be > 0 and fit in the file"),
+            ));
+        }
+        let bytes = c.take(path, n as u64 * 8, &field)?;
+        let mut rows = Vec::with_capacity(n as usize);
+        for (k, pair) in bytes.chunks_exact(8).enumerate() {
+            let (nm, v) = (f32_at(pair, 0) as f64, f32_at(pair, 4) as f64);
+            let ok = nm.is_finite()
+                && nm > 0.0
+                && v.is_finite()
+                && v >= 0.0
+                && rows.last().is_none_or(|p: &[f64; 2]| nm > p[0]);
+            if !ok {
+                return Err(bad(
+                    path,
+                    c.at - n as u64 * 8 + 8 * k as u64,
+                    &field,
+                    format!(
+                        "row {k}: [{nm} nm, {v}]: wavelengths must be positive and increasing, values finite and >= 0"
+                    ),
+                ));
+            }
+            rows.push([nm, v]);
+        }
+        first.get_or_insert(rows);
+    }
+    let pad = (32 - (c.at - start) % 32) % 32;
+    c.take(path, pad, "spectral tables' padding (4.7.4)")?;
+    Ok(first)
+}
+
+/// The ray records, in chunks: positions, unit directions, flux and wavelengths checked.
+fn read_rays<R: Read>(
+    path: &Path,
+    c: &mut Cursor<R>,
+    h: &Header,
+    per_ray_nm: bool,
+) -> Result<(Vec<StoredRay>, Vec<f32>)> {
+    let cols = h.columns() as usize;
+    let flux_col = if h.flags[2] {
+        6
+    } else {
+        6 + h.flags[3] as usize
+    };
+    let n = h.rays as usize;
+    let mut rays = Vec::with_capacity(n);
+    let mut nm = Vec::with_capacity(if per_ray_nm { n } else { 0 });
+    let mut done = 0;
+    while done < n {
+        let k = (n - done).min(CHUNK_RAYS);
+        let start = c.at;
+        let bytes = c.take(path, (k * cols * 4) as u64, "ray records")?;
+        for (j, rec) in bytes.chunks_exact(cols * 4).enumerate() {
+            let v = |col: usize| f32_at(rec, 4 * col);
+            let at = |col: usize| start + (j * cols * 4 + 4 * col) as u64;
+            let wl = per_ray_nm.then(|| v(7));
+            let ray = check_ray([v(0), v(1), v(2)], [v(3), v(4), v(5)], v(flux_col), wl).map_err(
+                |(col, msg)| {
+                    let (byte, name) = match col {
+                        6 => (
+                            flux_col,
+                            if h.flags[2] {
+                                "radiant flux"
+                            } else {
+                                "luminous flux"
+                            },
+                        ),
+                        c => (c, COLUMN_NAMES[c]),
+                    };
+                    bad(path, at(byte), &format!("ray {} {name}", done + j), msg)
+                },
+            )?;
+            rays.push(ray);
+            if let Some(w) = wl {
+                nm.push(w);
+            }
+        }
+        done += k;
+    }
+    Ok((rays, nm))
+}
+
+/// Names of the first eight columns of a ray record, for errors.
+const COLUMN_NAMES: [&str; 8] = ["x", "y", "z", "kx", "ky", "kz", "flux", "wavelength"];
+
+/// Write `set` as a TM-25-13 file: radiant (or luminous) flux per ray, a wavelength per
+/// ray, one wavelength or one spectral table, as the set holds.
+pub fn write(path: &Path, set: &RaySet) -> Result<()> {
+    if set.unit == FluxUnit::Lumen && matches!(set.spectrum, FileSpectrum::PerRay) {
+        bail!(
+            "{}: a wavelength per ray needs radiant flux (TM-25-13 4.7.2.5)",
+            path.display()
+        );
+    }
+    let head = header_bytes(set).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let file = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+    let mut w = BufWriter::with_capacity(1 << 20, file);
+    w.write_all(&head)?;
+    if let FileSpectrum::Table(rows) = &set.spectrum {
+        let mut block = (rows.len() as i32).to_le_bytes().to_vec();
+        for r in rows {
+            block.extend((r[0] as f32).to_le_bytes());
+            block.extend((r[1] as f32).to_le_bytes());
+        }
+        block.resize(block.len().div_ceil(32) * 32, 0);
+        w.write_all(&block)?;
+    }
+    let per_ray = matches!(set.spectrum, FileSpectrum::PerRay);
+    for (i, r) in set.rays.iter().enumerate() {
+        for x in r.pos.iter().chain(&r.dir).chain([&r.flux]) {
+            w.write_all(&x.to_le_bytes())?;
+        }
+        if per_ray {
+            w.write_all(&set.nm[i].to_le_bytes())?;
+        }
+    }
+    w.flush()
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+}
+
+/// The header, flags and text fields of `set` (36288 bytes).
+fn header_bytes(set: &RaySet) -> Result<Vec<u8>> {
+    let mut b = Vec::with_capacity(TABLES_AT as usize);
+    b.extend(b"TM25");
+    b.extend(2013i32.to_le_bytes());
+    b.extend(0i32.to_le_bytes());
+    let total = set.total_flux() as f32;
+    let (lm, w) = match set.unit {
+        FluxUnit::Watt => (f32::NAN, total),
+        FluxUnit::Lumen => (total, f32::NAN),
+    };
+    b.extend(lm.to_le_bytes());
+    b.extend(w.to_le_bytes());
+    b.extend((set.rays.len() as u64).to_le_bytes());
+    b.extend([0u8; 28]);
+    b.extend(0i32.to_le_bytes());
+    let (id, single, tables) = match &set.spectrum {
+        FileSpectrum::None => (0i32, f32::NAN, 0i32),
+        FileSpectrum::Single(nm) => (1, *nm as f32, 0),
+        FileSpectrum::PerRay => (2, f32::NAN, 0),
+        FileSpectrum::Table(_) => (3, f32::NAN, 1),
+    };
+    let (lo, hi) = set
+        .wavelength_range()
+        .map_or((f32::NAN, f32::NAN), |(a, b)| (a as f32, b as f32));
+    b.extend(id.to_le_bytes());
+    for x in [single, lo, hi] {
+        b.extend(x.to_le_bytes());
+    }
+    for x in [tables, 0i32, 0i32] {
+        b.extend(x.to_le_bytes());
+    }
+    b.resize(HEADER_BYTES, 0);
+    let watt = set.unit == FluxUnit::Watt;
+    let per_ray = matches!(set.spectrum, FileSpectrum::PerRay);
+    for f in [true, true, watt, per_ray, !watt, false, false, false] {
+        b.extend((f as i32).to_le_bytes());
+    }
+    for (k, t) in set.text.iter().enumerate() {
+        let codes: Vec<char> = t.chars().collect();
+        if codes.len() >= TEXT_BYTES / 4 || codes.contains(&'\0') {
+            bail!(
+                "text field 4.7.3.{}: at most {} characters and no NUL, got {}",
+                k + 1,
+                TEXT_BYTES / 4 - 1,
+                codes.len()
+            );
+        }
+        let start = b.len();
+        codes
+            .iter()
+            .for_each(|&ch| b.extend((ch as u32).to_le_bytes()));
+        b.resize(start + TEXT_BYTES, 0);
+    }
+    Ok(b)
+}

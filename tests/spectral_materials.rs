@@ -79,6 +79,9 @@ fn fraction(r: &RunResult, f: &dyn Fn(&Ledger) -> f64) -> (f64, f64) {
     (f(l) / l.photons as f64, (var / k).sqrt())
 }
 
+/// Picks a power out of a ledger.
+type Pick<'a> = &'a dyn Fn(&Ledger) -> f64;
+
 fn medium_named<'a>(scene: &'a Scene, name: &str) -> &'a Medium {
     scene.media.iter().find(|m| m.name == name).unwrap()
 }
@@ -161,7 +164,7 @@ fn a_pmma_prism_disperses_blue_and_red_as_snell_and_sellmeier_say() {
     let mut seen = Vec::new();
     for nm in [450.0, 650.0] {
         let dir = prism_scene(nm, PMMA_SELLMEIER);
-        let r = run(&load(&*dir), 4000, 11, Estimator::Analog);
+        let r = run(&load(&dir), 4000, 11, Estimator::Analog);
         let (got, want) = (traced_deviation_deg(&r), snell_deviation_deg(pmma_n(nm)));
         eprintln!("{nm} nm: traced {got:.4} deg, Snell {want:.4} deg");
         assert!(
@@ -212,7 +215,7 @@ fn the_mie_tables_are_the_mie_sum_at_each_wavelength() {
         "n = {PMMA_SELLMEIER}\nparticles = {{ radius_um = 1.0, n = {{ table = [[400, 1.43], [700, 1.41]] }}, volume_fraction = 0.01 }}"
     );
     let dir = slab("mie-tables", &medium, &narrow_band(550.0));
-    let scene = load(&*dir);
+    let scene = load(&dir);
     let s = &medium_named(&scene, "slab").scattering;
     assert!(s.per_mm.is_spectral() && s.anisotropy.is_spectral());
     for (nm, tol) in [
@@ -252,7 +255,7 @@ fn bohren_huffmans_worked_example_holds_at_every_wavelength_it_is_scaled_to() {
             "n = 1.0\nparticles = {{ radius_um = {r}, n = 1.55, volume_fraction = 0.001 }}"
         );
         let dir = slab("bhmie", &medium, &narrow_band(550.0));
-        let scene = load(&*dir);
+        let scene = load(&dir);
         let s = &medium_named(&scene, "slab").scattering;
         let l = Light::at_nm(nm);
         let want = 3.0 * 0.001 * 3.10543 / (4.0 * r * 1e-3);
@@ -282,7 +285,7 @@ fn small_absorbing_spheres_follow_rayleigh_at_each_wavelength() {
         "n = {PMMA_SELLMEIER}\nparticles = {{ radius_um = {r}, n = 2.0, k = {{ table = [[400, 0.1], [700, 0.01]] }}, volume_fraction = {f} }}"
     );
     let dir = slab("rayleigh", &medium, &narrow_band(550.0));
-    let scene = load(&*dir);
+    let scene = load(&dir);
     let m = medium_named(&scene, "slab");
     for nm in [400.0, 500.0, 600.0, 700.0] {
         let n_host = pmma_n(nm);
@@ -315,7 +318,7 @@ fn monochrome_particles_stay_one_evaluation_at_their_wavelength() {
         "n = {PMMA_SELLMEIER}\nparticles = {{ radius_um = 1.0, n = 1.42, volume_fraction = 0.01, wavelength_nm = 480.0 }}"
     );
     let dir = slab("mono-mie", &medium, "");
-    let scene = load(&*dir);
+    let scene = load(&dir);
     let s = &medium_named(&scene, "slab").scattering;
     let host = medium_named(&scene, "slab").index(Light::at_nm(480.0));
     let b = mie::bulk(1.0, 1.42, 0.0, 0.01, 480.0, host);
@@ -324,7 +327,7 @@ fn monochrome_particles_stay_one_evaluation_at_their_wavelength() {
     // The same medium in a spectral scene: tabulated, and the unused wavelength_nm is
     // named in a warning.
     let dir = slab("spectral-mie", &medium, &narrow_band(480.0));
-    let scene = load(&*dir);
+    let scene = load(&dir);
     assert!(medium_named(&scene, "slab").scattering.per_mm.is_spectral());
     assert!(
         scene
@@ -358,7 +361,7 @@ fn bad_spectral_particle_input_names_the_field() {
     ] {
         let medium = format!("n = 1.49\nparticles = {particles}");
         let dir = slab("bad-particles", &medium, &narrow_band(550.0));
-        let e = format!("{:#}", Scene::load(&*dir).err().expect(particles));
+        let e = format!("{:#}", Scene::load(&dir).expect_err(particles));
         assert!(
             e.contains("scene.toml") && e.contains(want),
             "{particles}: {e}"
@@ -380,12 +383,12 @@ fn an_absorption_table_attenuates_each_wavelength_as_beer_lambert_says() {
         (410.0, 2.0 - 10.0 / 150.0),
         (475.0, 1.5),
         (620.0, 0.65),
-        (690.0, 0.3),
+        (690.0, 0.3_f64),
     ] {
         let dir = slab("beer", medium, &narrow_band(nm));
-        let r = run(&load(&*dir), 2000, 5, Estimator::Weighted);
+        let r = run(&load(&dir), 2000, 5, Estimator::Weighted);
         let (t, _) = fraction(&r, &|l| l.detected.sum.value());
-        let want = (-a as f64).exp();
+        let want = (-a).exp();
         assert!(
             (t / want - 1.0).abs() < 1e-4,
             "{nm} nm: transmitted {t}, Beer-Lambert exp(-{a}) = {want}"
@@ -401,7 +404,7 @@ fn a_broad_spectrum_transmits_the_mean_of_beer_lambert_over_it() {
     let medium = "n = 1.0\nabsorption_per_mm = { table = [[400, 2.0], [550, 1.0], [700, 0.25]] }";
     let source = "spectrum = { table = [[400, 1.0], [700, 1.0]] }";
     let dir = slab("beer-broad", medium, source);
-    let r = run(&load(&*dir), 200_000, 9, Estimator::Analog);
+    let r = run(&load(&dir), 200_000, 9, Estimator::Analog);
     let (t, err) = fraction(&r, &|l| l.detected.sum.value());
     // The mean of exp(-a) over a segment where a goes linearly from a0 to a1.
     let seg = |a0: f64, a1: f64| ((-a1).exp() - (-a0).exp()) / (a0 - a1);
@@ -456,10 +459,10 @@ fn narrow_band_against_monochrome(nm: f64) {
     let spectral = slab("narrow", &bead_slab_medium(true, nm), &narrow_band(nm));
     let mono = slab("mono", &bead_slab_medium(false, nm), "");
     let (rs, rm) = (
-        run(&load(&*spectral), photons, 21, Estimator::Analog),
-        run(&load(&*mono), photons, 22, Estimator::Analog),
+        run(&load(&spectral), photons, 21, Estimator::Analog),
+        run(&load(&mono), photons, 22, Estimator::Analog),
     );
-    let ledgers: [(&str, &dyn Fn(&Ledger) -> f64); 2] = [
+    let ledgers: [(&str, Pick); 2] = [
         ("reflected", &|l: &Ledger| l.escaped.value()),
         ("transmitted", &|l: &Ledger| l.detected.sum.value()),
     ];
@@ -508,7 +511,7 @@ fn the_pmma_snippet_matches_sultanovas_measured_indices_and_its_sources() {
         ("pmma-fibre-grade.toml", f64::NAN),
     ] {
         let dir = slab_with_snippet(file, "[media.pmma]");
-        let scene = load(&*dir);
+        let scene = load(&dir);
         let m = medium_named(&scene, "slab");
         for (nm, measured) in [
             (436.8, 1.502),
@@ -546,7 +549,7 @@ fn the_pmma_snippet_matches_sultanovas_measured_indices_and_its_sources() {
 #[test]
 fn the_pc_bead_snippet_disperses_as_sultanova_measured_and_tabulates_its_beads() {
     let dir = slab_with_snippet("pc-bead-diffuser.toml", "[media.pc]");
-    let scene = load(&*dir);
+    let scene = load(&dir);
     let m = medium_named(&scene, "slab");
     for (nm, measured) in [
         (436.8, 1.612),

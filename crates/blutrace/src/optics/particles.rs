@@ -142,7 +142,7 @@ impl ParticlesSpec {
             None => "spectral".to_string(),
         };
         let k = match self.k.constant() {
-            Some(x) if x == 0.0 => String::new(),
+            Some(0.0) => String::new(),
             _ => format!(" + {}i", value(&self.k)),
         };
         let at = if spectral {

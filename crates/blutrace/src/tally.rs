@@ -8,8 +8,12 @@
 //! associative, so any thread count, chunk order or shard split gives bit-identical
 //! totals, and 1e10 photons accumulate without drift. They are read out as f64.
 
+pub mod color;
+
+use crate::optics::spectrum::Light;
 use crate::optics::surface::MediumId;
 use crate::scene::Scene;
+pub use color::{ColorTally, ScoredXyz};
 use serde::{Deserialize, Serialize};
 
 const FRACTION_BITS: i32 = 64;
@@ -448,15 +452,24 @@ pub struct Tally {
     pub angular: Grid,
     /// Energy ledger.
     pub ledger: Ledger,
+    /// X, Y, Z of the detected light, when the sources have spectra ([`color`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<ColorTally>,
 }
 
 impl Tally {
     /// An empty tally shaped for `scene`.
     pub fn new(scene: &Scene) -> Self {
         let d = &scene.detector;
+        let flux = Grid::new(d.bins[0], d.bins[1]);
+        let angular = Grid::new(d.angular_bins[0], d.angular_bins[1]);
         Self {
-            flux: Grid::new(d.bins[0], d.bins[1]),
-            angular: Grid::new(d.angular_bins[0], d.angular_bins[1]),
+            color: scene
+                .sources
+                .spectral()
+                .then(|| ColorTally::new(&flux, &angular)),
+            flux,
+            angular,
             ledger: Ledger::new(
                 scene.tags.len(),
                 scene.media.len(),
@@ -484,6 +497,9 @@ impl Tally {
                 ),
                 (l.absorbed_in_medium.len(), l.absorbed_by_source.len(), 0),
             ]
+            .into_iter()
+            .chain(t.color.iter().flat_map(ColorTally::shape))
+            .collect::<Vec<_>>()
         };
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
         let negative = sinks
@@ -515,7 +531,10 @@ impl Tally {
             )
         } else if negative || l.detected.hits > photons || l.killed_photons > photons {
             "a sink holds negative weight, or more photons than were emitted".into()
-        } else if bad_bin(&self.flux) || bad_bin(&self.angular) {
+        } else if bad_bin(&self.flux)
+            || bad_bin(&self.angular)
+            || self.color.as_ref().is_some_and(|c| c.has_bad_bin(photons))
+        {
             "a bin holds negative weight, or more photons than were emitted".into()
         } else {
             return None;
@@ -532,6 +551,9 @@ impl Tally {
     pub fn checked_merge(&mut self, o: &Tally) -> Option<()> {
         self.flux.checked_merge(&o.flux)?;
         self.angular.checked_merge(&o.angular)?;
+        if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
+            a.checked_merge(b)?;
+        }
         self.ledger.checked_merge(&o.ledger)
     }
 
@@ -539,20 +561,31 @@ impl Tally {
     pub fn merge_signed(&mut self, o: &Tally, sign: Sign) {
         self.flux.merge_signed(&o.flux, sign);
         self.angular.merge_signed(&o.angular, sign);
+        if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
+            a.merge_signed(b, sign);
+        }
         self.ledger.merge_signed(&o.ledger, sign);
     }
 
     /// Add the events of one traced chunk.
     pub fn absorb(&mut self, c: &ChunkTally) {
-        self.absorb_scored(c, &c.scored());
+        let xyz = match self.color {
+            Some(_) => ColorTally::scored(&c.detections),
+            None => Vec::new(),
+        };
+        self.absorb_scored(c, &c.scored(), &xyz);
     }
 
     /// Add the events of one traced chunk whose detections are `scored`
-    /// ([`ChunkTally::scored`]).
-    pub fn absorb_scored(&mut self, c: &ChunkTally, scored: &[BinStats]) {
+    /// ([`ChunkTally::scored`]) with colours `xyz` ([`ColorTally::scored`]; empty when the
+    /// tally has no colour).
+    pub fn absorb_scored(&mut self, c: &ChunkTally, scored: &[BinStats], xyz: &[ScoredXyz]) {
         for (d, one) in c.detections.iter().zip(scored) {
             self.flux.bins[d.flux_bin as usize].merge(one);
             self.angular.bins[d.angular_bin as usize].merge(one);
+        }
+        if let Some(color) = &mut self.color {
+            color.absorb(&c.detections, xyz);
         }
         self.ledger.merge(&c.ledger);
     }
@@ -567,6 +600,8 @@ pub struct Detection {
     pub angular_bin: u32,
     /// Photon weight at detection.
     pub weight: f64,
+    /// The photon's light (its wavelength, for the colour tallies).
+    pub light: Light,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between

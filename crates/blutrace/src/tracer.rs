@@ -164,7 +164,7 @@ impl<'a> Tracer<'a> {
             if let Some((_, ab)) = detected {
                 let weight = p.light.detected(p.weight);
                 out.detections
-                    .push(detection(scene, ab, true_ray.dir, weight));
+                    .push(detection(scene, ab, true_ray.dir, weight, p.light));
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
@@ -456,12 +456,19 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
     }
 }
 
-fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64) -> Detection {
+fn detection(
+    scene: &Scene,
+    ab: [f64; 2],
+    dir: glam::DVec3,
+    weight: f64,
+    light: Light,
+) -> Detection {
     let d = &scene.detector;
     Detection {
         flux_bin: d.flux_index(ab) as u32,
         angular_bin: d.angular_index(dir) as u32,
         weight,
+        light,
     }
 }
 

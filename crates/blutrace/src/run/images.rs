@@ -69,9 +69,7 @@ pub(super) fn write_flux_png(run: &RunResult, path: &Path, flux: &Map) -> Result
 
 /// `flux.exr` of the map `flux`.
 pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Result<()> {
-    let d = &run.scene.detector;
-    let bin = d.bin_size();
-    let mut attrs = common_attributes(
+    let attrs = map_attributes(
         run,
         "W/mm^2",
         "blutrace flux map: Y = irradiance on the target plane (W/mm^2 per bin), \
@@ -79,14 +77,6 @@ pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Re
          preview.Y = Y / (2 * mean) for display; \
          x along detector_u, y along detector_v from detector_origin_mm",
     );
-    for (name, v) in [
-        ("bin_size_x_mm", bin[0]),
-        ("bin_size_y_mm", bin[1]),
-        ("size_x_mm", d.size[0]),
-        ("size_y_mm", d.size[1]),
-    ] {
-        attrs.push((name, Attribute::Text(v.to_string())));
-    }
     let (value, stderr, hits) = (f32s(&flux.value), f32s(&flux.stderr), counts(&flux.hits));
     let preview = preview(&flux.value);
     staged.write_with("flux.exr", |path| {
@@ -138,6 +128,27 @@ pub(super) fn write_angular_exr(run: &RunResult, staged: &SetDir) -> Result<()> 
         write_channels(path, ang.nx, ang.ny, &channels, &attrs)
     })?;
     Ok(())
+}
+
+/// The attributes of a target map (`flux.exr`, `color.exr`): the common ones and the
+/// bin and target sizes.
+pub(super) fn map_attributes(
+    run: &RunResult,
+    units: &str,
+    comments: &str,
+) -> Vec<(&'static str, Attribute)> {
+    let d = &run.scene.detector;
+    let bin = d.bin_size();
+    let mut attrs = common_attributes(run, units, comments);
+    for (name, v) in [
+        ("bin_size_x_mm", bin[0]),
+        ("bin_size_y_mm", bin[1]),
+        ("size_x_mm", d.size[0]),
+        ("size_y_mm", d.size[1]),
+    ] {
+        attrs.push((name, Attribute::Text(v.to_string())));
+    }
+    attrs
 }
 
 /// The attributes both images carry.

@@ -10,6 +10,7 @@
 //! noise floor, the cv a perfectly uniform source would show at this photon count
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
 
+pub mod color;
 mod jackknife;
 
 pub use jackknife::{
@@ -53,13 +54,24 @@ pub fn angular_map(scene: &Scene, t: &Tally) -> Map {
     }))
 }
 
+/// The angular grid luminance is read from, and lumens per watt of its weights: in a
+/// spectral scene the Y tally (683 lm/W times ȳ at each photon's wavelength, so the
+/// colour shifts along the way count), else the radiant weights times the sources' given
+/// efficacy (`None` without lumens).
+fn luminous_grid<'t>(scene: &Scene, t: &'t Tally) -> Option<(&'t Grid, f64)> {
+    match &t.color {
+        Some(c) => Some((&c.angular[1], crate::color::KM_LM_PER_W)),
+        None => Some((&t.angular, scene.sources.luminous_efficacy()?)),
+    }
+}
+
 /// Luminance (cd/m^2) averaged over the target, per (theta, phi) bin; x = phi, y = theta.
-/// Needs the sources' lumens; `None` otherwise. L = K P / (A * projected solid angle).
+/// Needs the sources' lumens or spectra; `None` otherwise. L = K P / (A * projected solid
+/// angle).
 pub fn luminance_map(scene: &Scene, t: &Tally) -> Option<Map> {
-    let efficacy = scene.sources.luminous_efficacy()?;
+    let (g, efficacy) = luminous_grid(scene, t)?;
     let d = &scene.detector;
     let area_m2 = d.area_m2();
-    let g = &t.angular;
     let m = grid_map(scene, t, g, |i| {
         d.angular_bin_projected_solid_angle(i % g.nx) * area_m2 / efficacy
     });
@@ -69,14 +81,14 @@ pub fn luminance_map(scene: &Scene, t: &Tally) -> Option<Map> {
 /// Luminance (cd/m^2) per theta row, averaged over phi: (theta centre in degrees, value,
 /// standard error). Each photon lands in one bin, so row sums of squares are exact.
 pub fn luminance_by_theta(scene: &Scene, t: &Tally) -> Option<Vec<[f64; 3]>> {
-    let efficacy = scene.sources.luminous_efficacy()?;
+    let (g, efficacy) = luminous_grid(scene, t)?;
     let d = &scene.detector;
     let area_m2 = d.area_m2();
-    let (nt, np) = (t.angular.nx, t.angular.ny);
+    let (nt, np) = (g.nx, g.ny);
     let watts = scene.sources.total_power();
     let rows = (0..nt).map(|it| {
         let mut row = crate::tally::BinStats::default();
-        (0..np).for_each(|ip| row.merge(&t.angular.bins[ip * nt + it]));
+        (0..np).for_each(|ip| row.merge(&g.bins[ip * nt + it]));
         let (mean, se) = row.mean_and_stderr(t.ledger.photons);
         let k = watts * efficacy / (area_m2 * d.angular_bin_projected_solid_angle(it) * np as f64);
         [d.theta_centre_deg(it), mean * k, se * k]
@@ -159,15 +171,10 @@ impl Uniformity {
         let n = v.len() as f64;
         let mean = sums.value / n;
         let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
-        let nine = [1.0 / 6.0, 0.5, 5.0 / 6.0];
-        let mut points: Vec<(f64, f64)> = nine
-            .iter()
-            .flat_map(|&y| nine.iter().map(move |&x| (x, y)))
-            .collect();
+        let points = thirteen_points();
         let spot =
             |pts: &[(f64, f64)]| min_over_max(pts.iter().map(|&(x, y)| spot_mean(nx, ny, v, x, y)));
-        let nine_point = spot(&points);
-        points.extend([(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]);
+        let nine_point = spot(&points[..9]);
         Uniformity {
             mean,
             cv: if mean > 0.0 {
@@ -234,6 +241,20 @@ fn min_over_max(values: impl Iterator<Item = f64>) -> f64 {
 /// Smallest over largest (NaN when nothing is lit).
 fn ratio(lo: f64, hi: f64) -> f64 {
     if hi > 0.0 { lo / hi } else { f64::NAN }
+}
+
+/// The 13 standard points as fractions of the map's sides: the 9 at 1/6, 1/2 and 5/6 of
+/// each side (y slowest), then the 4 at 1/4 and 3/4.
+pub fn thirteen_points() -> [(f64, f64); 13] {
+    let nine = [1.0 / 6.0, 0.5, 5.0 / 6.0];
+    let mut p = [(0.0, 0.0); 13];
+    for (i, &y) in nine.iter().enumerate() {
+        for (j, &x) in nine.iter().enumerate() {
+            p[3 * i + j] = (x, y);
+        }
+    }
+    p[9..].copy_from_slice(&[(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]);
+    p
 }
 
 /// Mean of the 3x3 bins around the fractional position (fx, fy) of an `nx` x `ny` map.

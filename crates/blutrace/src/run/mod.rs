@@ -19,6 +19,7 @@
 //! - `convergence.csv`, `convergence.png`: metrics and errors against photons and time;
 //! - `summary.json`: run facts, energy ledger, uniformity and errors.
 
+mod color_images;
 mod images;
 pub mod mesh_build;
 pub mod metrics;
@@ -280,7 +281,9 @@ pub const TALLY_BUDGET_BYTES: u64 = 4 << 30;
 pub fn tally_bytes(scene: &Scene) -> u64 {
     let d = &scene.detector;
     let bins = (d.bins[0] * d.bins[1] + d.angular_bins[0] * d.angular_bins[1]) as u64;
-    bins * std::mem::size_of::<crate::tally::BinStats>() as u64 * (GROUPS as u64 + 1)
+    // Spectral scenes tally X, Y, Z beside the radiant weight.
+    let grids = if scene.sources.spectral() { 4 } else { 1 };
+    bins * grids * std::mem::size_of::<crate::tally::BinStats>() as u64 * (GROUPS as u64 + 1)
 }
 
 /// [`tally_bytes`], or an error when over the budget.
@@ -457,6 +460,7 @@ impl RunResult {
         let flux = self.flux_map();
         images::write_flux_exr(self, staged, &flux)?;
         images::write_angular_exr(self, staged)?;
+        color_images::write_color_images(self, staged)?;
         staged.write_with("flux.png", |png| images::write_flux_png(self, png, &flux))?;
         staged.write_bytes(
             "convergence.csv",

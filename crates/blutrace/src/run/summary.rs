@@ -1,5 +1,6 @@
 //! `summary.json`, `convergence.csv` and `convergence.png`.
 
+use super::metrics::color::{ColorSummary, color_summary};
 use super::metrics::{Metric, MetricValues, Metrics, Uniformity};
 use super::{ConvergenceRow, RunResult, StoppedBy, TargetMetric, relative_error};
 use crate::optics::surface::Estimator;
@@ -64,8 +65,12 @@ pub struct Summary {
     pub mean_rel_stderr: f64,
     /// Monte Carlo efficiency of the run.
     pub figure_of_merit: FigureOfMerit,
-    /// Luminance, when the sources give their lumens.
+    /// Luminance, when the sources give their lumens or spectra.
     pub luminance: Option<LuminanceSummary>,
+    /// The target light's colour and colour uniformity, when the sources have spectra
+    /// ([`super::metrics::color`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub color: Option<ColorSummary>,
     /// Detector geometry.
     pub detector: DetectorSummary,
     /// Scene-loading warnings.
@@ -265,6 +270,7 @@ impl RunResult {
                         .collect(),
                 }
             }),
+            color: color_summary(&self.scene, &self.tally, &self.groups),
             detector: DetectorSummary {
                 origin_mm: (d.origin + self.scene.offset).to_array(),
                 u: d.u.to_array(),

@@ -31,7 +31,7 @@
 //! (free paths, scattering events) is the tracer's (`tracer::flight`); the phase
 //! function is [`super::phase`].
 
-pub use super::particles::ParticlesSpec;
+pub use super::particles::{MAX_VOLUME_FRACTION, ParticlesSpec};
 use super::phase::{self, PhaseTable};
 use super::sampling;
 use super::spectrum::{Light, Range, Spectral, SpectralValue};
@@ -196,10 +196,6 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
-/// Above this volume fraction particles scatter dependently (near neighbours interfere),
-/// which the independent-scattering Mie sum does not describe.
-pub const MAX_VOLUME_FRACTION: f64 = 0.1;
-
 /// The default of a face's or source's `outside`/`medium`: the ambient medium.
 pub fn air() -> String {
     "air".into()
@@ -275,9 +271,13 @@ impl MediumSpec {
                     "give either particles or scattering_per_mm and anisotropy, not both",
                 ));
             }
-            let optics = p.optics(ctx, &field("particles"), &n, spectral)?;
-            absorption = absorption.plus(&optics.absorption_per_mm);
-            scattering = optics.scattering;
+            let bulk = p.optics(ctx, &field("particles"), &n, spectral)?;
+            absorption = absorption.plus(&bulk.absorption_per_mm);
+            scattering = Scattering {
+                per_mm: bulk.scattering_per_mm,
+                anisotropy: bulk.anisotropy,
+                table: None,
+            };
         }
         Ok(Medium {
             name: name.to_string(),
@@ -287,6 +287,17 @@ impl MediumSpec {
             particles: self.particles.clone(),
         })
     }
+}
+
+/// Warnings for a spectral scene's media: a particles' `wavelength_nm` it does not use.
+pub fn spectral_warnings(specs: &BTreeMap<String, MediumSpec>) -> Vec<String> {
+    specs
+        .iter()
+        .filter_map(|(name, m)| {
+            let field = format!("media.{name}.particles");
+            m.particles.as_ref()?.spectral_warning(&field)
+        })
+        .collect()
 }
 
 /// The id of the medium named `name` (given at `field`).

@@ -17,13 +17,11 @@
 //! size parameter `2 pi r n_host / lambda` at each wavelength; `wavelength_nm` is then not
 //! used (a warning says so).
 
-use super::medium::{MAX_VOLUME_FRACTION, Scattering};
-use super::mie;
+use super::mie::{self, BulkSpectra};
 use super::spectrum::{Light, Range, Spectral, SpectralValue};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 
 /// `particles = { ... }`: spheres of one size dispersed in the medium (see [`super::mie`]).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -44,6 +42,10 @@ pub struct ParticlesSpec {
     pub wavelength_nm: Option<f64>,
 }
 
+/// Above this volume fraction particles scatter dependently (near neighbours interfere),
+/// which the independent-scattering Mie sum does not describe.
+pub const MAX_VOLUME_FRACTION: f64 = 0.1;
+
 /// Where a monochrome scene evaluates particles without `wavelength_nm` (nm).
 pub const DEFAULT_WAVELENGTH_NM: f64 = 550.0;
 
@@ -55,30 +57,32 @@ fn is_no_k(k: &SpectralValue) -> bool {
     *k == no_k()
 }
 
-/// What particles add to their medium.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParticleOptics {
-    /// mu_s and g.
-    pub scattering: Scattering,
-    /// The particles' absorption (1/mm), added to the host's.
-    pub absorption_per_mm: Spectral,
-}
-
 impl ParticlesSpec {
+    /// A warning if a spectral scene's particles at `field` give a `wavelength_nm`, which
+    /// it does not use.
+    pub fn spectral_warning(&self, field: &str) -> Option<String> {
+        let nm = self.wavelength_nm?;
+        Some(format!(
+            "{field}.wavelength_nm = {nm} is not used: the scene is spectral, so the \
+             particles' Mie coefficients are tabulated over 360-830 nm"
+        ))
+    }
+
     /// The wavelength a monochrome scene evaluates the particles at (nm).
     pub fn monochrome_nm(&self) -> f64 {
         self.wavelength_nm.unwrap_or(DEFAULT_WAVELENGTH_NM)
     }
 
-    /// The checked particles' coefficients at `field` in a host of index `n_host`: over
-    /// wavelength if `spectral`, else at [`ParticlesSpec::monochrome_nm`].
+    /// The checked particles' coefficients (mu_s, their absorption, g) at `field` in a
+    /// host of index `n_host`: over wavelength if `spectral`, else constants at
+    /// [`ParticlesSpec::monochrome_nm`].
     pub fn optics(
         &self,
         ctx: &Ctx,
         field: &str,
         n_host: &Spectral,
         spectral: bool,
-    ) -> Result<ParticleOptics> {
+    ) -> Result<BulkSpectra> {
         let f = |s: &str| format!("{field}.{s}");
         let r = ctx.positive(&f("radius_um"), self.radius_um)?;
         if r > 1e4 {
@@ -97,26 +101,15 @@ impl ParticlesSpec {
         if spectral {
             let (_, n_max) = n_host.range();
             check_size_parameter(ctx, field, r, n_max, mie::TABLE_NM.0)?;
-            let b = mie::bulk_spectra(r, &n_p, &k_p, fv, n_host);
-            return Ok(ParticleOptics {
-                scattering: Scattering {
-                    per_mm: b.scattering_per_mm,
-                    anisotropy: b.anisotropy,
-                    table: None,
-                },
-                absorption_per_mm: b.absorption_per_mm,
-            });
+            return Ok(mie::bulk_spectra(r, &n_p, &k_p, fv, n_host));
         }
         let l = Light::at_nm(wl);
         check_size_parameter(ctx, field, r, n_host.at(l), wl)?;
         let b = mie::bulk(r, n_p.at(l), k_p.at(l), fv, wl, n_host.at(l));
-        Ok(ParticleOptics {
-            scattering: Scattering {
-                per_mm: Spectral::constant(b.scattering_per_mm),
-                anisotropy: Spectral::constant(b.anisotropy),
-                table: None,
-            },
+        Ok(BulkSpectra {
+            scattering_per_mm: Spectral::constant(b.scattering_per_mm),
             absorption_per_mm: Spectral::constant(b.absorption_per_mm),
+            anisotropy: Spectral::constant(b.anisotropy),
         })
     }
 
@@ -177,18 +170,4 @@ fn check_size_parameter(ctx: &Ctx, field: &str, r: f64, n_host: f64, nm: f64) ->
         ));
     }
     Ok(())
-}
-
-/// Warnings for a spectral scene's media: a `wavelength_nm` it does not use.
-pub fn spectral_warnings(media: &BTreeMap<String, super::medium::MediumSpec>) -> Vec<String> {
-    media
-        .iter()
-        .filter_map(|(name, m)| {
-            let nm = m.particles.as_ref()?.wavelength_nm?;
-            Some(format!(
-                "media.{name}.particles.wavelength_nm = {nm} is not used: the scene is \
-                 spectral, so the particles' Mie coefficients are tabulated over 360-830 nm"
-            ))
-        })
-        .collect()
 }

@@ -127,7 +127,7 @@ impl Scene {
         // A spectral scene's particles scatter over wavelength (Mie tabulated at load).
         let spectral = file.sources.iter().any(SourceSpec::has_spectrum);
         if spectral {
-            warnings.extend(crate::optics::particles::spectral_warnings(&file.media));
+            warnings.extend(medium::spectral_warnings(&file.media));
         }
         let media = medium::build_media(&ctx, &file.media, spectral)?;
         // Sources first: procedural reflectors follow the lamps.

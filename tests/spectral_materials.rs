@@ -3,7 +3,7 @@
 //! tabulation of a spectral scene (the direct Mie sum, Bohren & Huffman's worked example
 //! and the Rayleigh limit at each wavelength), Beer-Lambert with an absorption table,
 //! a narrow-band source against a monochrome run, and the material library
-//! (`scenes/materials/`) against the paper its dispersion comes from.
+//! (`materials/`) against the paper its dispersion comes from.
 
 mod support;
 
@@ -482,10 +482,10 @@ fn narrow_band_against_monochrome(nm: f64) {
 // ---------------------------------------------------------------------------------
 // The material library
 
-/// The snippet `scenes/materials/NAME`.
+/// The snippet `materials/NAME`.
 fn snippet(name: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes/materials")
+        .join("materials")
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

@@ -1,4 +1,4 @@
-"""Derive the PMMA absorption tables of scenes/materials/ (run: python3 pmma_absorption.py).
+"""Derive the PMMA absorption tables of materials/ (run: python3 pmma_absorption.py).
 
 Input: the PMMA polymer-optical-fibre attenuation spectrum as digitized in
 ander-vieira/fiberSimulations, csv/attenuationPMMA.csv (relative values; that project

@@ -14,6 +14,7 @@
 mod support;
 
 use blutrace::accel::BackendChoice;
+use blutrace::optics::spectrum::Spectral;
 use blutrace::optics::surface::Estimator;
 use blutrace::run::{RunOptions, RunResult};
 use blutrace::scene::Scene;
@@ -383,8 +384,8 @@ fn particles_give_the_mie_coefficients() {
     let scene = load(&path);
     let m = scene.media.iter().find(|m| m.name == "slab").unwrap();
     let b = blutrace::optics::mie::bulk(2.0, 1.43, 0.0, 0.001, 550.0, 1.49);
-    assert_eq!(m.scattering.per_mm, b.scattering_per_mm);
-    assert_eq!(m.scattering.anisotropy, b.anisotropy);
+    assert_eq!(m.scattering.per_mm, Spectral::constant(b.scattering_per_mm));
+    assert_eq!(m.scattering.anisotropy, Spectral::constant(b.anisotropy));
     assert!(b.scattering_per_mm > 0.0 && b.anisotropy > 0.8 && b.anisotropy < 1.0);
     assert_eq!(m.absorption_per_mm.nominal(), 0.0);
 }
@@ -447,7 +448,7 @@ fn a_phase_table_of_henyey_greenstein_gives_the_same_slab() {
     let m = scene.media.iter().find(|m| m.name == "slab").unwrap();
     assert!(m.scattering.table.is_some());
     assert!(
-        (m.scattering.anisotropy - g).abs() < 2e-3,
+        (m.scattering.anisotropy.nominal() - g).abs() < 2e-3,
         "{}",
         m.scattering.anisotropy
     );

@@ -31,22 +31,11 @@ fn bounds(b: Option<BoxMm>) -> String {
 /// particles the coefficients come from.
 fn scattering(m: &Medium) -> String {
     let s = &m.scattering;
-    if s.per_mm == 0.0 {
+    if !s.scatters() {
         return String::new();
     }
     let from = match &m.particles {
-        Some(p) => format!(
-            " (Mie: spheres r = {} um, n = {}{}, volume fraction {}, at {} nm)",
-            p.radius_um,
-            p.n,
-            if p.k > 0.0 {
-                format!(" + {}i", p.k)
-            } else {
-                String::new()
-            },
-            p.volume_fraction,
-            p.wavelength_nm
-        ),
+        Some(p) => format!(" (Mie: {})", p.describe(s.per_mm.is_spectral())),
         None => String::new(),
     };
     let phase = if s.table.is_some() {
@@ -54,11 +43,20 @@ fn scattering(m: &Medium) -> String {
     } else {
         "anisotropy g ="
     };
+    let (mu_s, g, reduced) = (&s.per_mm, &s.anisotropy, s.reduced_per_mm());
+    if !mu_s.is_spectral() && !g.is_spectral() {
+        return format!(
+            ", scattering {:.6} /mm, {phase} {:.4}, reduced {:.6} /mm{from}",
+            mu_s.nominal(),
+            g.nominal(),
+            reduced.nominal()
+        );
+    }
     format!(
-        ", scattering {:.6} /mm, {phase} {:.4}, reduced {:.6} /mm{from}",
-        s.per_mm,
-        s.anisotropy,
-        s.reduced_per_mm()
+        ", scattering {} /mm, {phase} {}, reduced {} /mm{from}",
+        spread(mu_s, 6),
+        spread(g, 4),
+        spread(&reduced, 6)
     )
 }
 
@@ -82,6 +80,12 @@ fn rayfile_lines(r: &RayFileSummary, spectrum: Option<&EmissionSpectrum>) {
         format!("; {:.1} lm/W", s.efficacy_lm_per_w())
     });
     say!("    wavelengths         {}{efficacy}", r.spectrum);
+}
+
+/// "a..b over 360-830 nm" of a spectral quantity, with `digits` decimals.
+fn spread(q: &blutrace::optics::spectrum::Spectral, digits: usize) -> String {
+    let (lo, hi) = q.range();
+    format!("{lo:.digits$}..{hi:.digits$} over 360-830 nm")
 }
 
 pub(super) fn check(path: &Path, json: bool) -> Result<()> {

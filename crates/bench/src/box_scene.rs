@@ -215,10 +215,10 @@ impl BoxScene {
             bail!(refuse(scene, "it needs exactly one medium besides air"));
         }
         let (air, guide) = (&scene.media[0], &scene.media[1]);
-        if air.absorption_per_mm.nominal() != 0.0 || air.scattering.per_mm != 0.0 {
+        if air.absorption_per_mm.nominal() != 0.0 || air.scattering.scatters() {
             bail!(refuse(scene, "the air must be clear"));
         }
-        if guide.scattering.per_mm != 0.0 {
+        if guide.scattering.scatters() {
             bail!(refuse(scene, format!("medium '{}' scatters", guide.name)));
         }
         let mesh = &scene.mesh;

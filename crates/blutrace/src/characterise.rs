@@ -254,7 +254,10 @@ impl<'a> Part<'a> {
         rng: &mut PhotonRng,
     ) -> Option<bool> {
         let light = Light::MONOCHROME;
-        let (mu_a, mu_s) = (medium.absorption(light), medium.scattering.per_mm);
+        let (mu_a, mu_s) = (
+            medium.absorption(light),
+            medium.scattering.coefficient(light),
+        );
         let mu_t = mu_a + mu_s;
         for _ in 0..MAX_EVENTS {
             let h = (*p - start).dot(self.n).clamp(-thick, 0.0);
@@ -279,7 +282,7 @@ impl<'a> Part<'a> {
             }
             *dir = medium
                 .scattering
-                .scatter(*dir, rng.uniform(), rng.uniform());
+                .scatter(*dir, light, rng.uniform(), rng.uniform());
         }
         None
     }

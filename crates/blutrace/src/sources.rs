@@ -98,6 +98,11 @@ impl SourceSpec {
         }
     }
 
+    /// Whether the entry gives an emission spectrum (then the scene is spectral).
+    pub fn has_spectrum(&self) -> bool {
+        self.common().spectrum.is_some()
+    }
+
     fn common(&self) -> Common<'_> {
         match self {
             SourceSpec::Ccfl(s) => Common {

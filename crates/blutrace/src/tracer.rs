@@ -311,7 +311,7 @@ impl<'a> Tracer<'a> {
     ) -> Flight {
         let medium = &self.scene.media[p.medium as usize];
         let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
-        if medium.scattering.per_mm > 0.0 {
+        if medium.scattering.scatters() {
             let eps = self.scene.spawn_eps;
             let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
             let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);

@@ -21,12 +21,17 @@
 //! particles = { radius_um = 2.0, n = 1.43, volume_fraction = 0.001, wavelength_nm = 550.0 }
 //! ```
 //!
+//! `n` and `absorption_per_mm` may be tables (and `n` a dispersion formula, see
+//! [`super::spectrum`]); particles' coefficients are tabulated over wavelength in a
+//! spectral scene ([`super::particles`]), so mu_s and g are [`Spectral`] too.
+//!
 //! The medium `air` (n = 1, lossless, clear) exists unless the file redefines it; it is
 //! the unbounded ambient medium, so it may absorb but not scatter. Surfaces and sources
 //! name media, the scene numbers them ([`MediumId`]). How a photon crosses a medium
 //! (free paths, scattering events) is the tracer's (`tracer::flight`); the phase
 //! function is [`super::phase`].
 
+pub use super::particles::{MAX_VOLUME_FRACTION, ParticlesSpec};
 use super::phase::{self, PhaseTable};
 use super::sampling;
 use super::spectrum::{Light, Range, Spectral, SpectralValue};
@@ -66,7 +71,7 @@ impl Medium {
     /// scattering): a face may name it outside with no solid around it, as an
     /// index-matched black coating of no thickness.
     pub fn is_backing(&self) -> bool {
-        self.absorption_per_mm.nominal() >= BACKING_PER_MM && self.scattering.per_mm == 0.0
+        self.absorption_per_mm.nominal() >= BACKING_PER_MM && !self.scattering.scatters()
     }
 
     /// The refractive index for a photon of light `light`.
@@ -94,13 +99,14 @@ impl Medium {
 }
 
 /// Volume scattering: free paths of mean `1 / per_mm` between events, and the phase
-/// function: Henyey-Greenstein with the anisotropy, or a measured table.
+/// function: Henyey-Greenstein with the anisotropy, or a measured table. Both are read
+/// at a photon's light (tables only where particles in a spectral scene made them).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scattering {
     /// Scattering coefficient mu_s (1/mm); 0 = clear.
-    pub per_mm: f64,
+    pub per_mm: Spectral,
     /// The mean cosine of the scattering angle: the Henyey-Greenstein g, or the table's.
-    pub anisotropy: f64,
+    pub anisotropy: Spectral,
     /// A measured phase function, used instead of Henyey-Greenstein.
     pub table: Option<Arc<PhaseTable>>,
 }
@@ -108,23 +114,44 @@ pub struct Scattering {
 impl Scattering {
     /// A clear medium.
     pub const NONE: Scattering = Scattering {
-        per_mm: 0.0,
-        anisotropy: 0.0,
+        per_mm: Spectral::constant(0.0),
+        anisotropy: Spectral::constant(0.0),
         table: None,
     };
 
-    /// The direction after scattering a photon travelling along unit `dir`, from two
-    /// uniform numbers.
-    pub fn scatter(&self, dir: DVec3, u1: f64, u2: f64) -> DVec3 {
+    /// Whether it scatters at all (a table is built only for a medium that does).
+    #[inline]
+    pub fn scatters(&self) -> bool {
+        match &self.per_mm {
+            Spectral::Constant(v) => *v > 0.0,
+            Spectral::Sampled(_) => true,
+        }
+    }
+
+    /// The scattering coefficient mu_s (1/mm) for a photon of light `light`.
+    #[inline]
+    pub fn coefficient(&self, light: Light) -> f64 {
+        self.per_mm.at(light)
+    }
+
+    /// The direction after scattering a photon of light `light` travelling along unit
+    /// `dir`, from two uniform numbers.
+    pub fn scatter(&self, dir: DVec3, light: Light, u1: f64, u2: f64) -> DVec3 {
         match &self.table {
             Some(t) => sampling::around(dir, t.cos_theta(u1), u2),
-            None => phase::scatter(dir, self.anisotropy, u1, u2),
+            None => phase::scatter(dir, self.anisotropy.at(light), u1, u2),
         }
     }
 
     /// The reduced scattering coefficient `mu_s (1 - g)` (1/mm): what decides diffusion.
-    pub fn reduced_per_mm(&self) -> f64 {
-        self.per_mm * (1.0 - self.anisotropy)
+    pub fn reduced_per_mm(&self) -> Spectral {
+        match (&self.per_mm, &self.anisotropy) {
+            (Spectral::Constant(s), Spectral::Constant(g)) => Spectral::constant(s * (1.0 - g)),
+            _ => Spectral::sampled(|nm| {
+                let l = Light::at_nm(nm);
+                self.per_mm.at(l) * (1.0 - self.anisotropy.at(l))
+            }),
+        }
     }
 }
 
@@ -161,28 +188,6 @@ pub struct MediumSpec {
     pub particles: Option<ParticlesSpec>,
 }
 
-/// `particles = { ... }`: spheres of one size dispersed in the medium (see [`super::mie`]).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ParticlesSpec {
-    /// Sphere radius (micrometres).
-    pub radius_um: f64,
-    /// Real refractive index of the particles.
-    pub n: f64,
-    /// Imaginary refractive index of the particles (absorbing if > 0).
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub k: f64,
-    /// Fraction of the medium's volume the particles take.
-    pub volume_fraction: f64,
-    /// Vacuum wavelength the coefficients are computed at (nm).
-    #[serde(default = "default_wavelength_nm")]
-    pub wavelength_nm: f64,
-}
-
-fn default_wavelength_nm() -> f64 {
-    550.0
-}
-
 fn no_absorption() -> SpectralValue {
     SpectralValue::Constant(0.0)
 }
@@ -191,23 +196,24 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
-/// Above this volume fraction particles scatter dependently (near neighbours interfere),
-/// which the independent-scattering Mie sum does not describe.
-pub const MAX_VOLUME_FRACTION: f64 = 0.1;
-
 /// The default of a face's or source's `outside`/`medium`: the ambient medium.
 pub fn air() -> String {
     "air".into()
 }
 
 /// The scene's medium table from its `[media.*]` sections: air first (index 0, redefined
-/// if the file names it), then the others in name order.
-pub fn build_media(ctx: &Ctx, specs: &BTreeMap<String, MediumSpec>) -> Result<Vec<Medium>> {
+/// if the file names it), then the others in name order; particles' coefficients over
+/// wavelength if `spectral` (some source has a spectrum), else at their `wavelength_nm`.
+pub fn build_media(
+    ctx: &Ctx,
+    specs: &BTreeMap<String, MediumSpec>,
+    spectral: bool,
+) -> Result<Vec<Medium>> {
     let mut media = vec![Medium::clear("air", 1.0, 0.0)];
     for (name, spec) in specs {
-        let m = spec.build(ctx, name)?;
+        let m = spec.build(ctx, name, spectral)?;
         if name == "air" {
-            if m.scattering.per_mm > 0.0 {
+            if m.scattering.scatters() {
                 return Err(ctx.err(
                     "media.air",
                     "the ambient medium is unbounded and cannot scatter \
@@ -226,8 +232,8 @@ pub fn build_media(ctx: &Ctx, specs: &BTreeMap<String, MediumSpec>) -> Result<Ve
 }
 
 impl MediumSpec {
-    /// The checked medium `name`.
-    fn build(&self, ctx: &Ctx, name: &str) -> Result<Medium> {
+    /// The checked medium `name` (its particles over wavelength if `spectral`).
+    fn build(&self, ctx: &Ctx, name: &str, spectral: bool) -> Result<Medium> {
         let field = |f: &str| format!("media.{name}.{f}");
         let n = self.n.build(ctx, &field("n"), Range::Index)?;
         let mut absorption =
@@ -242,8 +248,8 @@ impl MediumSpec {
             ));
         }
         let mut scattering = Scattering {
-            per_mm: mu_s,
-            anisotropy: g,
+            per_mm: Spectral::constant(mu_s),
+            anisotropy: Spectral::constant(g),
             table: None,
         };
         if let Some(rows) = &self.phase_table {
@@ -255,7 +261,7 @@ impl MediumSpec {
                 return Err(ctx.err(&f, "needs scattering_per_mm > 0"));
             }
             let t = PhaseTable::new(rows).map_err(|e| ctx.err(&f, e))?;
-            scattering.anisotropy = t.mean_cosine;
+            scattering.anisotropy = Spectral::constant(t.mean_cosine);
             scattering.table = Some(Arc::new(t));
         }
         if let Some(p) = &self.particles {
@@ -265,8 +271,8 @@ impl MediumSpec {
                     "give either particles or scattering_per_mm and anisotropy, not both",
                 ));
             }
-            let bulk = p.bulk(ctx, &field("particles"), n.nominal())?;
-            absorption = absorption.plus(&Spectral::constant(bulk.absorption_per_mm));
+            let bulk = p.optics(ctx, &field("particles"), &n, spectral)?;
+            absorption = absorption.plus(&bulk.absorption_per_mm);
             scattering = Scattering {
                 per_mm: bulk.scattering_per_mm,
                 anisotropy: bulk.anisotropy,
@@ -283,42 +289,15 @@ impl MediumSpec {
     }
 }
 
-impl ParticlesSpec {
-    /// The checked particles' bulk coefficients in a host of index `n_host`.
-    fn bulk(&self, ctx: &Ctx, field: &str, n_host: f64) -> Result<super::mie::Bulk> {
-        let f = |s: &str| format!("{field}.{s}");
-        let r = ctx.positive(&f("radius_um"), self.radius_um)?;
-        if r > 1e4 {
-            return Err(ctx.err(
-                &f("radius_um"),
-                format!("must be at most 1e4 um (10 mm), got {r}"),
-            ));
-        }
-        let n_p = ctx.positive(&f("n"), self.n)?;
-        let k_p = ctx.non_negative(&f("k"), self.k)?;
-        let fv = ctx.positive(&f("volume_fraction"), self.volume_fraction)?;
-        if fv > MAX_VOLUME_FRACTION {
-            return Err(ctx.err(
-                &f("volume_fraction"),
-                format!(
-                    "must be at most {MAX_VOLUME_FRACTION} (beyond it particles scatter \
-                     dependently, which the Mie sum does not describe), got {fv}"
-                ),
-            ));
-        }
-        let wl = ctx.positive(&f("wavelength_nm"), self.wavelength_nm)?;
-        let x = 2.0 * std::f64::consts::PI * r * 1e3 * n_host / wl;
-        if x > 2e4 {
-            return Err(ctx.err(
-                field,
-                format!(
-                    "size parameter 2 pi r n / lambda = {x:.0} is beyond 2e4: \
-                     geometric optics, not Mie, describes such particles"
-                ),
-            ));
-        }
-        Ok(super::mie::bulk(r, n_p, k_p, fv, wl, n_host))
-    }
+/// Warnings for a spectral scene's media: a particles' `wavelength_nm` it does not use.
+pub fn spectral_warnings(specs: &BTreeMap<String, MediumSpec>) -> Vec<String> {
+    specs
+        .iter()
+        .filter_map(|(name, m)| {
+            let field = format!("media.{name}.particles");
+            m.particles.as_ref()?.spectral_warning(&field)
+        })
+        .collect()
 }
 
 /// The id of the medium named `name` (given at `field`).
@@ -378,16 +357,19 @@ mod tests {
             toml::from_str(&toml::to_string(&specs).unwrap()).unwrap();
         let ctx = Ctx(Path::new("scene.toml"));
         assert_eq!(
-            build_media(&ctx, &specs).unwrap(),
-            build_media(&ctx, &again).unwrap()
+            build_media(&ctx, &specs, false).unwrap(),
+            build_media(&ctx, &again, false).unwrap()
         );
         let clear = toml::to_string(&specs["c"]).unwrap();
         assert!(
             !clear.contains("scattering") && !clear.contains("anisotropy"),
             "{clear}"
         );
-        let media = build_media(&ctx, &specs).unwrap();
-        assert_eq!(media[2].scattering.per_mm, 4.0);
-        assert_eq!(media[1].particles.as_ref().unwrap().wavelength_nm, 550.0);
+        let media = build_media(&ctx, &specs, false).unwrap();
+        assert_eq!(media[2].scattering.per_mm, Spectral::constant(4.0));
+        assert_eq!(media[1].particles.as_ref().unwrap().monochrome_nm(), 550.0);
+        let spectral = build_media(&ctx, &specs, true).unwrap();
+        assert!(spectral[1].scattering.per_mm.is_spectral());
+        assert_eq!(spectral[2], media[2], "no particles: nothing to tabulate");
     }
 }

@@ -19,7 +19,13 @@
 //! and diffusion light guides) and samples the Henyey-Greenstein phase function with the
 //! Mie asymmetry `g`, the usual stand-in for the full Mie phase function, whose forward
 //! peak and ripples it leaves out; the transport-relevant `mu_s (1 - g)` is exact.
+//!
+//! In a spectral scene the coefficients are tabulated over wavelength at load
+//! ([`bulk_spectra`]): a Mie evaluation every [`TABLE_STEP_NM`] from 360 to 830 nm, with
+//! the particles' and the host's indices read at each, linear between. A monochrome scene
+//! evaluates them once, at the particles' `wavelength_nm` ([`bulk`]).
 
+use super::spectrum::{Light, Spectral};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -116,6 +122,86 @@ pub fn bulk(
     }
 }
 
+/// The wavelength step of the Mie tabulation of a spectral scene (nm).
+pub const TABLE_STEP_NM: f64 = 5.0;
+
+/// The first and last wavelengths of the tabulation (nm): the CIE observer's range.
+pub const TABLE_NM: (f64, f64) = (360.0, 830.0);
+
+/// The bulk coefficients of a medium holding spheres at one size, over wavelength.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BulkSpectra {
+    /// Scattering coefficient (1/mm).
+    pub scattering_per_mm: Spectral,
+    /// Absorption coefficient of the particles (1/mm).
+    pub absorption_per_mm: Spectral,
+    /// Asymmetry parameter.
+    pub anisotropy: Spectral,
+}
+
+/// [`bulk`] every [`TABLE_STEP_NM`] over [`TABLE_NM`], linear between: spheres of radius
+/// `radius_um`, index `n_p + i k_p`, at `volume_fraction` in a host of index `n_host`,
+/// each index read at the wavelength of the evaluation. A quantity that is the same at
+/// every node comes back a constant, and so does the absorption of clear spheres (`k_p`
+/// zero everywhere): exactly zero, where `Q_ext - Q_sca` leaves rounding of 1e-15.
+pub fn bulk_spectra(
+    radius_um: f64,
+    n_p: &Spectral,
+    k_p: &Spectral,
+    volume_fraction: f64,
+    n_host: &Spectral,
+) -> BulkSpectra {
+    let nodes: Vec<Bulk> = (0..table_len())
+        .map(|i| {
+            let nm = node_nm(i);
+            let l = Light::at_nm(nm);
+            bulk(
+                radius_um,
+                n_p.at(l),
+                k_p.at(l),
+                volume_fraction,
+                nm,
+                n_host.at(l),
+            )
+        })
+        .collect();
+    let column = |f: fn(&Bulk) -> f64| -> Spectral {
+        let v: Vec<f64> = nodes.iter().map(f).collect();
+        if v.iter().all(|&x| x == v[0]) {
+            return Spectral::constant(v[0]);
+        }
+        Spectral::sampled(|nm| between_nodes(&v, nm))
+    };
+    BulkSpectra {
+        scattering_per_mm: column(|b| b.scattering_per_mm),
+        absorption_per_mm: if k_p.range() == (0.0, 0.0) {
+            Spectral::constant(0.0)
+        } else {
+            column(|b| b.absorption_per_mm)
+        },
+        anisotropy: column(|b| b.anisotropy),
+    }
+}
+
+/// How many wavelengths the tabulation evaluates.
+fn table_len() -> usize {
+    ((TABLE_NM.1 - TABLE_NM.0) / TABLE_STEP_NM).round() as usize + 1
+}
+
+/// The wavelength of node `i` (nm).
+fn node_nm(i: usize) -> f64 {
+    TABLE_NM.0 + TABLE_STEP_NM * i as f64
+}
+
+/// Node values `v` at `nm`: linear between nodes (a node's own value on it), the end
+/// values beyond.
+fn between_nodes(v: &[f64], nm: f64) -> f64 {
+    let x = ((nm - TABLE_NM.0) / TABLE_STEP_NM).clamp(0.0, (v.len() - 1) as f64);
+    let i = (x as usize).min(v.len() - 2);
+    let f = x - i as f64;
+    v[i] + f * (v[i + 1] - v[i])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,5 +264,39 @@ mod tests {
         let e = efficiencies(Complex64::new(1.43 / 1.49, 0.0), x);
         let want = 3.0 * 0.001 * e.qsca / (4.0 * 2e-3);
         assert!((one.scattering_per_mm - want).abs() < 1e-12 * want);
+    }
+
+    #[test]
+    fn tabulation_is_the_mie_sum_at_its_nodes_and_linear_between() {
+        // PMMA-like host with dispersion, silicone-like spheres: every 5 nm the table is
+        // the direct evaluation; halfway between two nodes it is their mean.
+        let host = Spectral::sampled(|nm| 1.48 + 4.0e3 / (nm * nm));
+        let n_p = Spectral::constant(1.42);
+        let k_p = Spectral::constant(0.0);
+        let t = bulk_spectra(1.0, &n_p, &k_p, 0.01, &host);
+        assert_eq!(t.absorption_per_mm, Spectral::constant(0.0));
+        let direct = |nm: f64| {
+            let l = Light::at_nm(nm);
+            bulk(1.0, 1.42, 0.0, 0.01, nm, host.at(l))
+        };
+        for nm in [360.0, 450.0, 555.0, 650.0, 830.0] {
+            let (b, l) = (direct(nm), Light::at_nm(nm));
+            close(
+                "mu_s",
+                t.scattering_per_mm.at(l),
+                b.scattering_per_mm,
+                1e-12,
+            );
+            close("g", t.anisotropy.at(l), b.anisotropy, 1e-12);
+        }
+        let (a, b) = (direct(450.0), direct(455.0));
+        let mid = t.scattering_per_mm.at(Light::at_nm(452.5));
+        close(
+            "mu_s mid",
+            mid,
+            0.5 * (a.scattering_per_mm + b.scattering_per_mm),
+            1e-9,
+        );
+        assert!(t.scattering_per_mm.at(Light::at_nm(400.0)) != b.scattering_per_mm);
     }
 }

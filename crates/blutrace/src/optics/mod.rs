@@ -7,7 +7,7 @@
 //! [`diffuser`] (rough diffusing faces), [`phong`], [`lambert`], [`mirror`] and
 //! [`absorber`]; [`surface`] joins them into the per-tag model and its Russian roulette.
 //! Shared by several: [`medium`] (media and interfaces; volume scattering with
-//! [`phase`] and [`mie`]), [`fresnel`] (Fresnel equations
+//! [`phase`], [`mie`] and [`particles`]), [`fresnel`] (Fresnel equations
 //! and roulette), [`sampling`] (direction sampling) [`density`] (values graded along
 //! a guide) and [`spectrum`] (the light a photon carries and the quantities read at it).
 
@@ -26,6 +26,7 @@ pub mod mie;
 pub mod mirror;
 pub mod model;
 pub mod opaque;
+pub mod particles;
 pub mod phase;
 pub mod phong;
 pub mod placement;

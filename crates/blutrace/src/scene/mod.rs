@@ -26,7 +26,7 @@ use crate::detector::TargetPlane;
 use crate::geometry::{Aabb, Mesh, spawn_epsilon};
 use crate::optics::medium::{self, Medium, MediumId};
 use crate::optics::surface::{Face, SurfaceModel};
-use crate::sources::Sources;
+use crate::sources::{SourceSpec, Sources};
 use crate::spec_check::{Ctx, MAX_COORDINATE};
 use anyhow::{Context, Result};
 use config::SceneFile;
@@ -124,9 +124,15 @@ impl Scene {
             ));
         }
         let mut warnings = Vec::new();
-        let media = medium::build_media(&ctx, &file.media)?;
+        // A spectral scene's particles scatter over wavelength (Mie tabulated at load).
+        let spectral = file.sources.iter().any(SourceSpec::has_spectrum);
+        if spectral {
+            warnings.extend(medium::spectral_warnings(&file.media));
+        }
+        let media = medium::build_media(&ctx, &file.media, spectral)?;
         // Sources first: procedural reflectors follow the lamps.
         let sources = Sources::build(&ctx, &file.sources, &media)?;
+        debug_assert_eq!(spectral, sources.spectral());
         let (mut mesh, tags, geometry) =
             load_geometry(&ctx, file, path, &sources.list, &mut warnings, reads)?;
         let (mut surfaces, mut backs) = (Vec::new(), Vec::new());

@@ -10,6 +10,9 @@
 //!   here, exactly as in a clear medium (where `mu_s = 0` leaves plain Beer-Lambert), and
 //!   the expected weight per path is the analog's.
 //!
+//! mu_a, mu_s and g are read at the photon's light (tables only in spectral scenes; a
+//! constant is one branch).
+//!
 //! Clear media never come here (the tracer keeps its Beer-Lambert step for them), so a
 //! scene without scattering draws the same random numbers as before the feature.
 
@@ -53,7 +56,10 @@ pub(super) fn fly(
     rng: &mut PhotonRng,
     absorbed: &mut ExactSum,
 ) -> Flight {
-    let (mu_a, mu_s) = (medium.absorption(light), medium.scattering.per_mm);
+    let (mu_a, mu_s) = (
+        medium.absorption(light),
+        medium.scattering.coefficient(light),
+    );
     let path = |rng: &mut PhotonRng, mu: f64| -(1.0 - rng.uniform()).ln() / mu;
     let t = match estimator {
         Estimator::Analog => {
@@ -88,6 +94,6 @@ pub(super) fn fly(
     let (u1, u2) = (rng.uniform(), rng.uniform());
     Flight::Scattered {
         t,
-        dir: medium.scattering.scatter(dir, u1, u2),
+        dir: medium.scattering.scatter(dir, light, u1, u2),
     }
 }

@@ -95,7 +95,7 @@ impl<'a> Walks<'a> {
             .collect();
         let walkable = |m: usize| {
             let solid = convex_solid(scene, convex, m as MediumId)?;
-            let clear = solid.clear_of_target && scene.media[m].scattering.per_mm == 0.0;
+            let clear = solid.clear_of_target && !scene.media[m].scattering.scatters();
             (clear && !bodies.any_in(m as MediumId)).then_some(solid)
         };
         Walks {

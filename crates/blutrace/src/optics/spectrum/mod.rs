@@ -158,6 +158,9 @@ fn grid_nm(i: usize) -> f64 {
 }
 
 /// `t` (on the 1 nm grid) at `nm`: linear between grid points, the end values beyond.
+/// Out of line: it keeps [`Spectral::at`] a load and one predictable branch where the
+/// quantity is constant (monochrome scenes read mu_s, g and mu_a at every free flight),
+/// for the price of a call where it is a table.
 #[inline(never)]
 fn read_grid(t: &[f64], nm: f64) -> f64 {
     let x = ((nm - CMF_FIRST_NM) / CMF_STEP_NM).clamp(0.0, (t.len() - 1) as f64);

@@ -49,6 +49,7 @@ pub fn all_files() -> Vec<GenFile> {
     let mut files = Vec::new();
     files.extend(scenes::notebook14::files());
     files.extend(scenes::notebook14_led::files());
+    files.extend(scenes::notebook14_color::files());
     files.extend(scenes::wedge_ccfl::files());
     files.extend(scenes::edge_holder::files());
     files.extend(scenes::test_slab::files());

@@ -9,6 +9,7 @@ pub mod direct_lit;
 pub mod direct_lit_rows;
 pub mod edge_holder;
 pub mod notebook14;
+pub mod notebook14_color;
 pub mod notebook14_led;
 pub mod phone_led;
 pub mod prism_plate;

@@ -569,11 +569,16 @@ impl Tally {
 
     /// Add the events of one traced chunk.
     pub fn absorb(&mut self, c: &ChunkTally) {
-        let xyz = match self.color {
+        self.absorb_scored(c, &c.scored(), &self.scored_xyz(c));
+    }
+
+    /// The X, Y, Z of `c`'s detections when this tally keeps colour (else none), for
+    /// [`Tally::absorb_scored`].
+    pub fn scored_xyz(&self, c: &ChunkTally) -> Vec<ScoredXyz> {
+        match self.color {
             Some(_) => ColorTally::scored(&c.detections),
             None => Vec::new(),
-        };
-        self.absorb_scored(c, &c.scored(), &xyz);
+        }
     }
 
     /// Add the events of one traced chunk whose detections are `scored`

@@ -13,6 +13,7 @@
 //!   non-uniformity map), false colour from 0.
 
 use super::RunResult;
+use super::images::f32s;
 use super::metrics::Map;
 use super::metrics::color::xyz_maps;
 use crate::color::{UvPrime, Xyz};
@@ -75,7 +76,6 @@ fn write_exr(
     rgb: &[Vec<f64>; 3],
     uv: &[Option<UvPrime>],
 ) -> Result<()> {
-    let f32s = |v: &[f64]| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
     let comments = "blutrace colour map: R, G, B = linear sRGB (D65) of the light on the target, \
          Y = 1 being 1 lux; X, Y, Z = CIE 1931 tristimulus values (Y = illuminance, lm/m^2 per \
          bin); stderr.X/Y/Z their standard errors; u_prime, v_prime = CIE 1976 chromaticity \

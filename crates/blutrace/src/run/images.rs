@@ -180,7 +180,7 @@ fn common_attributes(
     ]
 }
 
-fn f32s(v: &[f64]) -> Vec<f32> {
+pub(super) fn f32s(v: &[f64]) -> Vec<f32> {
     v.iter().map(|&x| x as f32).collect()
 }
 

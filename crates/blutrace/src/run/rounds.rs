@@ -20,7 +20,7 @@
 use super::metrics::{self, GROUPS, MetricValues, ScoredBins};
 use super::{ConvergenceRow, Progress, RunOptions, StoppedBy, UNREACHABLE_AFTER, relative_error};
 use crate::scene::Scene;
-use crate::tally::{ChunkTally, ColorTally, Tally};
+use crate::tally::{ChunkTally, Tally};
 use crate::tracer::{CHUNK, Tracer};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -251,10 +251,7 @@ impl Rounds {
     /// Score a traced chunk into its group and the total.
     fn absorb(&mut self, chunk: &ChunkTally, progress: &(dyn Fn(Progress) + Sync)) {
         let scored = chunk.scored();
-        let xyz = match self.total.color {
-            Some(_) => ColorTally::scored(&chunk.detections),
-            None => Vec::new(),
-        };
+        let xyz = self.total.scored_xyz(chunk);
         let g = (chunk.index % GROUPS as u64) as usize;
         self.groups[g].absorb_scored(chunk, &scored, &xyz);
         let bins = &mut self.scored.sets_mut()[g];

@@ -64,16 +64,11 @@ impl<'de> Deserialize<'de> for SpectrumSpec {
         if let Some(name) = v.as_str() {
             return Ok(SpectrumSpec::Named(name.to_string()));
         }
-        let Some(t) = v.as_table().filter(|t| t.len() == 1) else {
-            return Err(D::Error::custom(format!(
-                "invalid type: {} {v}, {allowed}",
-                v.type_str()
-            )));
-        };
-        let (key, value) = t.iter().next().expect("one entry");
+        let (key, value) =
+            crate::optics::spectrum::one_key_table(&v, allowed).map_err(D::Error::custom)?;
         let bad = |e: toml::de::Error| D::Error::custom(format!("{key}: {}", e.message()));
         let value = value.clone();
-        match key.as_str() {
+        match key {
             "table" => Ok(SpectrumSpec::Table {
                 table: value.try_into().map_err(bad)?,
             }),

@@ -261,15 +261,9 @@ impl<'de> Deserialize<'de> for SpectralValue {
         if let Some(x) = v.as_float().or(v.as_integer().map(|i| i as f64)) {
             return Ok(SpectralValue::Constant(x));
         }
-        let Some(t) = v.as_table().filter(|t| t.len() == 1) else {
-            return Err(D::Error::custom(format!(
-                "invalid type: {} {v}, {allowed}",
-                v.type_str()
-            )));
-        };
-        let (key, value) = t.iter().next().expect("one entry");
+        let (key, value) = one_key_table(&v, allowed).map_err(D::Error::custom)?;
         let bad = |e: toml::de::Error| D::Error::custom(format!("{key}: {}", e.message()));
-        match key.as_str() {
+        match key {
             "table" => Ok(SpectralValue::Table {
                 table: value.clone().try_into().map_err(bad)?,
             }),
@@ -283,6 +277,23 @@ impl<'de> Deserialize<'de> for SpectralValue {
                 "unknown key '{other}': {allowed}"
             ))),
         }
+    }
+}
+
+/// The one key and its value of a scene-file table such as `{ table = ... }`, or the
+/// error for anything else (`allowed` says what is accepted): how [`SpectralValue`] and a
+/// source's spectrum read their forms.
+pub(crate) fn one_key_table<'v>(
+    v: &'v toml::Value,
+    allowed: &str,
+) -> Result<(&'v str, &'v toml::Value), String> {
+    match v.as_table().filter(|t| t.len() == 1) {
+        Some(t) => Ok(t
+            .iter()
+            .next()
+            .map(|(k, v)| (k.as_str(), v))
+            .expect("one entry")),
+        None => Err(format!("invalid type: {} {v}, {allowed}", v.type_str())),
     }
 }
 

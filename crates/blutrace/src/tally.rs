@@ -289,9 +289,9 @@ pub struct Ledger {
     pub emitted: ExactSum,
     /// Weight detected on the target (sum and sum of squares per photon).
     pub detected: BinStats,
-    /// Weight detected on the target per source, in source order: each detection scored
-    /// once and merged into `detected` and into its source's bin, so they add up to
-    /// `detected` exactly (sums, sums of squares and counts).
+    /// Weight detected on the target per source, in source order: the photon loop books
+    /// each detection to its source's bin, and `detected` is their sum, so they add up to
+    /// it exactly (sums, sums of squares and counts).
     #[serde(default)]
     pub detected_by_source: Vec<BinStats>,
     /// Weight absorbed per surface tag.
@@ -327,14 +327,8 @@ impl Ledger {
     /// Book the end of a photon of weight `w` emitted by source `source`.
     pub(crate) fn end(&mut self, fate: Fate, w: f64, source: usize) {
         match fate {
-            Fate::Detected => {
-                // Rounded once, merged twice: the per-source bins sum to `detected`
-                // exactly.
-                let mut one = BinStats::default();
-                one.add(w);
-                self.detected.merge(&one);
-                self.detected_by_source[source].merge(&one);
-            }
+            // Booked to its source only: `detected` is their sum ([`Ledger::sum_detected`]).
+            Fate::Detected => self.detected_by_source[source].add(w),
             Fate::AbsorbedBySurface(t) => self.absorbed_by_surface[t as usize].add(w),
             Fate::AbsorbedInMedium(m) => self.absorbed_in_medium[m as usize].add(w),
             Fate::AbsorbedBySource(i) => self.absorbed_by_source[i as usize].add(w),
@@ -345,6 +339,15 @@ impl Ledger {
             }
             Fate::Roulette => self.roulette.add(w),
         }
+    }
+
+    /// Set `detected` to the sum of the per-source detections (exact: integer sums), once
+    /// the photons [`Ledger::end`] booked are all traced: the photon loop then pays for one
+    /// bin per detection, as it did before detections were kept per source.
+    pub(crate) fn sum_detected(&mut self) {
+        let mut total = BinStats::default();
+        self.detected_by_source.iter().for_each(|b| total.merge(b));
+        self.detected = total;
     }
 
     /// Count one surface interaction on tag `tag`, which met the tag's pattern (ink, a

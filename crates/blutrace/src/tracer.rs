@@ -345,6 +345,7 @@ impl<'a> Tracer<'a> {
         for i in lo..hi {
             self.trace_photon(seed, i, &mut out);
         }
+        out.ledger.sum_detected();
         out
     }
 }

@@ -71,8 +71,12 @@ pub fn write_polar(path: &Path, grid: &PolarGrid, opts: &MapOptions) -> Result<(
     encode(path, size.0, size.1, &rgb, &comment).with_context(what)
 }
 
-/// Draw `grid` under `opts`: image size, RGB pixels and the colour range.
-fn render_polar(grid: &PolarGrid, opts: &MapOptions) -> Result<((u32, u32), Vec<u8>, (f64, f64))> {
+/// A drawn figure: image size (pixels), 8-bit RGB pixels (rows from the top) and the
+/// colour range.
+type Drawn = ((u32, u32), Vec<u8>, (f64, f64));
+
+/// Draw `grid` under `opts`.
+fn render_polar(grid: &PolarGrid, opts: &MapOptions) -> Result<Drawn> {
     let (nt, np) = (grid.n_theta, grid.n_phi);
     ensure!(nt > 0 && np > 0, "empty grid ({nt} × {np})");
     ensure!(

@@ -59,15 +59,7 @@ def test_outputs_equal_the_command_lines_byte_for_byte(cli, box, run, tmp_path):
     mine = tmp_path / "py"
     files = run.write(mine)
     assert sorted(p.split("/")[-1] for p in files) == sorted(
-        [
-            "flux.exr",
-            "angular.exr",
-            "flux.png",
-            "conoscope.png",
-            "convergence.csv",
-            "convergence.png",
-            "summary.json",
-        ]
+        ["flux.exr", "angular.exr", "flux.png", "conoscope.png", "convergence.csv", "convergence.png", "summary.json"]
     )
     theirs = tmp_path / "cli"
     run_cli(cli, "trace", box.path, "--photons", str(N), "--seed", "3", "--quiet", "--out", str(theirs))

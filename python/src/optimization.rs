@@ -7,7 +7,8 @@ use crate::convert::{choice, count, run_error, serialized};
 use crate::detached::{detached, run_detached};
 use crate::scene::{BACKENDS, ESTIMATORS, Scene, threads_arg};
 use blutrace::optics::dots::Placement;
-use blutrace::optimize::layout::{ObjectiveSpec, VarySpec};
+use blutrace::optimize::ObjectiveSpec;
+use blutrace::optimize::layout::VarySpec;
 use blutrace::optimize::{
     LayoutResult, Method, OptimizeOptions, OptimizeResult, optimize, optimize_layout,
 };

@@ -258,8 +258,8 @@ impl Scene {
     /// Optimize the dot density ("nelder-mead", the default, or "feedback"), or with
     /// ``vary={"key": (lo, hi)}`` the numbers those key paths name ("nelder-mead" or
     /// "grid"). The options are those of ``blutrace optimize`` with underscores: ``photons`` (1e6 per design), ``seed``,
-    /// ``max_iter``, ``target_cv``, ``objective`` ("cv", "thirteen-point", "efficiency" or a mix
-    /// "cv=1,efficiency=0.5"), ``grid_points``, ``degree``, ``min_density``, ``max_density``,
+    /// ``max_iter``, ``target_cv``, ``objective`` ("cv", "thirteen-point", "efficiency",
+    /// "delta-uv-13pt" in spectral scenes, or a mix "cv=1,delta-uv-13pt=20"), ``grid_points``, ``degree``, ``min_density``, ``max_density``,
     /// ``tag``, ``initial_step``, ``simplex_tol``, ``alpha``, ``smoothing``, ``dims``, ``cells``,
     /// ``strips``, ``edge_margin_mm``, ``verify_photons`` (1e7; 0 for none), ``verify_seed``,
     /// ``threads``, ``estimator``, ``backend``, ``export_placement``; ``progress`` is True (one

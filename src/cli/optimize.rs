@@ -94,9 +94,14 @@ fn run_density(
     });
     blutrace::output::atomic::check_dest(&out, blutrace::optimize::OUTPUT_NAMES)?;
     let objective = if options.tunes_grid() {
-        "area cv of the flux map (2-D density grid)"
+        "area cv of the flux map (2-D density grid)".to_string()
+    } else if options.objective.reads_color() {
+        format!(
+            "{} (cv of the flux profile along the axis, Δu'v' 13-point of the colour)",
+            options.objective
+        )
     } else {
-        "cv of the flux profile along the axis"
+        "cv of the flux profile along the axis".to_string()
     };
     say!(
         "optimize   {} ({}) by {}: {} photons per design, seed {}, objective = {objective}",
@@ -250,8 +255,8 @@ fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {
     );
     say!(
         "{label:<10} profile cv {:.4} ± {:.4}; map cv {:.4} ± {:.4} (noise floor {:.4}, debiased {:.4} ± {:.4}), 13-pt {:.3} ± {:.3}, 9-pt {:.3} ± {:.3}, efficiency {:.4} ± {:.4}",
-        v.evaluation.objective,
-        v.evaluation.noise,
+        ev.cv,
+        ev.cv_noise,
         u.cv,
         e.cv,
         v.summary.cv_noise_floor,
@@ -264,6 +269,18 @@ fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {
         v.summary.extraction_efficiency,
         v.summary.extraction_efficiency_stderr,
     );
+    if let Some(c) = &v.summary.color {
+        say!(
+            "{label:<10} colour Δu'v' 13-pt {:.4} ± {:.4} (noise floor {:.4}, debiased {:.4} ± {:.4}), CCT {:.0} ± {:.0} K",
+            c.delta_uv_13pt.value,
+            c.delta_uv_13pt.stderr,
+            c.delta_uv_13pt_noise_floor,
+            c.delta_uv_13pt_debiased.value,
+            c.delta_uv_13pt_debiased.stderr,
+            c.cct_k.value,
+            c.cct_k.stderr
+        );
+    }
 }
 
 /// Print the search's totals and the verification.
@@ -287,6 +304,20 @@ pub fn print_report(r: &OptimizeResult) {
         r.best.noise_floor,
         r.options.photons
     );
+    if let (Some(a), Some(b)) = (
+        r.initial.delta_uv_13pt_debiased,
+        r.best.delta_uv_13pt_debiased,
+    ) {
+        say!(
+            "colour     Δu'v' 13-point {:.4} ± {:.4} -> {:.4} ± {:.4}; profile cv {:.4} -> {:.4}",
+            a.value,
+            a.stderr,
+            b.value,
+            b.stderr,
+            r.initial.cv,
+            r.best.cv
+        );
+    }
     match &r.final_density {
         blutrace::optics::dots::Density::Polynomial(c) => {
             let c: Vec<String> = c.iter().map(|v| format!("{v:.6}")).collect();

@@ -6,7 +6,8 @@ use super::enums;
 use blutrace::accel::BackendChoice;
 use blutrace::estimator::Estimator;
 use blutrace::optics::dots::Placement;
-use blutrace::optimize::layout::{ObjectiveSpec, VarySpec};
+use blutrace::optimize::ObjectiveSpec;
+use blutrace::optimize::layout::VarySpec;
 use blutrace::optimize::{Method, OptimizeOptions};
 
 /// How to optimize, as flags.
@@ -20,8 +21,10 @@ pub struct OptimizeFlags {
     /// such as sources.0.center.2, `*` for every element of an array (set together).
     #[arg(long, value_name = "KEY=MIN..MAX")]
     vary: Vec<VarySpec>,
-    /// With --vary: cv (debiased area cv), thirteen-point (1 - 13-point min/max),
-    /// efficiency (1 - extraction efficiency), or a weighted mix NAME=W,NAME=W.
+    /// What to minimize: cv (dots: the profile cv; with --vary: the debiased area cv),
+    /// thirteen-point (--vary: 1 - 13-point min/max), efficiency (--vary: 1 - extraction
+    /// efficiency), delta-uv-13pt (spectral scenes: the colour non-uniformity Δu'v'), or a
+    /// weighted mix NAME=W,NAME=W.
     #[arg(long, default_value = "cv")]
     objective: ObjectiveSpec,
     /// With --method grid: points per variable, ends included.

@@ -54,6 +54,7 @@ mod feedback_search;
 pub mod layout;
 pub mod nelder_mead;
 pub mod objective;
+pub mod objective_spec;
 mod options;
 mod polynomial_search;
 mod report;
@@ -64,6 +65,7 @@ mod verify;
 mod write;
 
 pub use layout::{LayoutResult, OUTPUT_NAMES as LAYOUT_OUTPUT_NAMES, optimize_layout};
+pub use objective_spec::{ObjectiveSpec, Term};
 pub use options::{Method, OptimizeOptions};
 pub use report::IterationReport;
 pub use result::{OptimizeResult, Verification, VerifiedDesign};

@@ -13,8 +13,15 @@
 //! delta method; the *noise floor* is the cv a perfectly uniform profile would show from
 //! noise alone. Every evaluation of one optimization uses the same seed (common random
 //! numbers), so two designs are compared on the same photon histories.
+//!
+//! With `--objective cv=W1,delta-uv-13pt=W2` ([`ObjectiveSpec`]) in a spectral scene the
+//! objective is `W1 cv + W2 Δu'v'_13pt`, the colour non-uniformity with its jackknife
+//! error; the two errors add in quadrature (the profile cv's error is the delta method's,
+//! which has no leave-one-out values to pair with the colour's).
 
+use super::objective_spec::{ObjectiveSpec, Term, TermValues};
 use crate::optics::dots::DotPattern;
+use crate::run::metrics::color::Estimate;
 use crate::run::metrics::{Map, Uniformity, median};
 use crate::scene::Scene;
 use serde::Serialize;
@@ -144,12 +151,18 @@ impl Profile {
 /// One evaluated design.
 #[derive(Clone, Debug, Serialize)]
 pub struct Evaluation {
-    /// The objective: cv of the profile's used strips.
+    /// The objective: the `--objective`'s weighted terms (by default the profile cv).
     pub objective: f64,
-    /// Its standard error (1 sigma, from the bins' standard errors).
+    /// Its standard error (1 sigma).
     pub noise: f64,
     /// The cv that noise alone would give a perfectly uniform profile.
     pub noise_floor: f64,
+    /// cv of the profile's used strips.
+    pub cv: f64,
+    /// Its standard error (from the bins' standard errors).
+    pub cv_noise: f64,
+    /// Colour non-uniformity Δu'v' 13-point with its jackknife error (spectral scenes).
+    pub delta_uv_13pt_debiased: Option<Estimate>,
     /// The profile along the propagation axis.
     pub profile: Profile,
     /// Uniformity metrics of the whole flux map (point estimates).
@@ -169,19 +182,51 @@ pub struct Evaluation {
     pub map: Map,
 }
 
+/// What a dots evaluation reads from a trace.
+pub struct Traced {
+    /// The flux map.
+    pub map: Map,
+    /// Δu'v' 13-point with its error (spectral scenes).
+    pub delta_uv_13pt_debiased: Option<Estimate>,
+    /// Photons traced.
+    pub photons: u64,
+    /// Tracing time (s).
+    pub seconds: f64,
+}
+
+/// What the dots search judges by: the objective and its strips.
+pub struct Judging<'a> {
+    /// The `--objective`.
+    pub spec: &'a ObjectiveSpec,
+    /// Profile strips along the pattern's axis.
+    pub strips: usize,
+    /// mm at either end of the span left out.
+    pub margin: f64,
+}
+
 impl Evaluation {
-    /// Evaluate a traced flux map.
-    pub fn of(
-        scene: &Scene,
-        pattern: &DotPattern,
-        map: Map,
-        strips: usize,
-        margin: f64,
-        photons: u64,
-        seconds: f64,
-    ) -> Self {
+    /// Evaluate a trace of `scene` (whose dots are `pattern`).
+    pub fn of(scene: &Scene, pattern: &DotPattern, traced: Traced, judging: &Judging) -> Self {
+        let Traced {
+            map,
+            delta_uv_13pt_debiased,
+            photons,
+            seconds,
+        } = traced;
+        let (strips, margin) = (judging.strips, judging.margin);
         let profile = Profile::of(scene, pattern, &map, strips, margin);
-        let (objective, noise, noise_floor) = profile.cv();
+        let (cv, cv_noise, noise_floor) = profile.cv();
+        let spec = judging.spec;
+        let duv = delta_uv_13pt_debiased.map_or(f64::NAN, |d| d.value);
+        let objective = spec.value(&TermValues {
+            cv,
+            thirteen_point: f64::NAN,
+            efficiency: f64::NAN,
+            delta_uv_13pt_debiased: duv,
+        });
+        let duv_se = delta_uv_13pt_debiased.map_or(0.0, |d| d.stderr);
+        let noise =
+            (spec.weight(Term::Cv) * cv_noise).hypot(spec.weight(Term::DeltaUv13pt) * duv_se);
         let (mut v, mut e) = (Vec::new(), Vec::new());
         for (i, k) in strip_of_bins(scene, pattern, map.nx, map.ny, strips)
             .into_iter()
@@ -197,6 +242,9 @@ impl Evaluation {
             objective,
             noise,
             noise_floor,
+            cv,
+            cv_noise,
+            delta_uv_13pt_debiased,
             profile,
             uniformity: Uniformity::of(&map),
             area_cv,

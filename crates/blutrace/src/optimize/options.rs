@@ -1,6 +1,7 @@
 //! How to optimize: the method and the options of `blutrace optimize`, checked.
 
-use super::layout::{ObjectiveSpec, VarySpec};
+use super::ObjectiveSpec;
+use super::layout::VarySpec;
 use crate::accel::BackendChoice;
 use crate::optics::dots::Placement;
 use crate::optics::surface::Estimator;
@@ -52,7 +53,7 @@ pub struct OptimizeOptions {
     pub method: Method,
     /// Numbers of the scene file to optimize, each a dotted key path and a range.
     pub vary: Vec<VarySpec>,
-    /// With `vary`: what to minimize.
+    /// What to minimize (see [`ObjectiveSpec`]).
     pub objective: ObjectiveSpec,
     /// With the grid method: points per variable, ends included.
     pub grid_points: usize,

@@ -16,7 +16,7 @@ pub struct IterationReport {
     pub photons: u64,
     /// Wall time so far (s).
     pub seconds: f64,
-    /// The best objective so far (profile cv).
+    /// The best objective so far (by default the profile cv).
     pub objective: f64,
     /// Its standard error.
     pub noise: f64,
@@ -28,6 +28,10 @@ pub struct IterationReport {
     pub area_cv: f64,
     /// 13-point min/max of the best design.
     pub thirteen_point: f64,
+    /// Profile cv of the best design.
+    pub cv: f64,
+    /// Colour non-uniformity Δu'v' 13-point of the best design (NaN: monochrome).
+    pub delta_uv_13pt_debiased: f64,
     /// What the iteration did (Nelder-Mead step, or "feedback").
     pub step: String,
     /// The best design's parameters: polynomial coefficients, or knot densities.
@@ -38,18 +42,25 @@ impl std::fmt::Display for IterationReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "iter {:>3}  evals {:>4}  photons {:>7.2}M  {:>6.1} s  cv {:.4} ± {:.4} (floor {:.4})  area cv {:.3}  map cv {:.3}  13-pt {:.3}  {:<12}",
+            "iter {:>3}  evals {:>4}  photons {:>7.2}M  {:>6.1} s  ",
             self.iteration,
             self.evaluations,
             self.photons as f64 * 1e-6,
             self.seconds,
-            self.objective,
-            self.noise,
-            self.noise_floor,
-            self.area_cv,
-            self.map_cv,
-            self.thirteen_point,
-            self.step
+        )?;
+        if self.delta_uv_13pt_debiased.is_nan() {
+            write!(f, "cv {:.4} ± {:.4}", self.objective, self.noise)?;
+        } else {
+            write!(
+                f,
+                "objective {:.4} ± {:.4}  cv {:.4}  Δu'v' {:.4}",
+                self.objective, self.noise, self.cv, self.delta_uv_13pt_debiased
+            )?;
+        }
+        write!(
+            f,
+            " (floor {:.4})  area cv {:.3}  map cv {:.3}  13-pt {:.3}  {:<12}",
+            self.noise_floor, self.area_cv, self.map_cv, self.thirteen_point, self.step
         )?;
         match self.method {
             Method::NelderMead => {

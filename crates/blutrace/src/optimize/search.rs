@@ -2,11 +2,13 @@
 
 use super::OptimizeOptions;
 use super::design::{Design, dots_pattern};
-use super::objective::{self, Evaluation};
+use super::objective::{self, Evaluation, Judging, Traced};
 use super::report::IterationReport;
 use crate::optics::dots::{Density, DotPattern, Gradation};
 use crate::optics::surface::SurfaceModel;
 use crate::run::RunResult;
+use crate::run::metrics::color::{self, Estimate};
+use crate::run::metrics::jackknife_stderr;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
@@ -132,6 +134,7 @@ impl<'a> Search<'a> {
         let pattern = dots_pattern(scene, tag_id)?.clone();
         let (min, max) = density_range(options, &pattern)?;
         let strips = checked_strips(scene, options, &pattern)?;
+        options.objective.check(scene, false, options.method)?;
         let run_options = options.search_run();
         Ok(Search {
             scene,
@@ -217,6 +220,8 @@ impl<'a> Search<'a> {
             map_cv: ev.uniformity.cv,
             area_cv: ev.area_cv,
             thirteen_point: ev.uniformity.thirteen_point_min_over_max,
+            cv: ev.cv,
+            delta_uv_13pt_debiased: ev.delta_uv_13pt_debiased.map_or(f64::NAN, |d| d.value),
             step,
             params,
         };
@@ -241,15 +246,23 @@ impl Design for Search<'_> {
 
     fn judge(&self, r: &RunResult) -> Result<Evaluation> {
         let pattern = dots_pattern(&r.scene, self.tag_id)?;
-        Ok(Evaluation::of(
-            &r.scene,
-            pattern,
-            r.flux_map(),
-            self.strips,
-            self.options.edge_margin_mm,
-            r.tally.ledger.photons,
-            r.runtime_s,
-        ))
+        let delta_uv_13pt_debiased = color::delta_uv_13pt_debiased(&r.scene, &r.tally, &r.groups)
+            .map(|(value, lo)| Estimate {
+                value,
+                stderr: jackknife_stderr(&lo),
+            });
+        let traced = Traced {
+            map: r.flux_map(),
+            delta_uv_13pt_debiased,
+            photons: r.tally.ledger.photons,
+            seconds: r.runtime_s,
+        };
+        let judging = Judging {
+            spec: &self.options.objective,
+            strips: self.strips,
+            margin: self.options.edge_margin_mm,
+        };
+        Ok(Evaluation::of(&r.scene, pattern, traced, &judging))
     }
 
     fn builds(&self) -> &RefCell<MeshBuildCache> {

@@ -28,7 +28,7 @@ impl OptimizeResult {
     /// `history.csv`: one row per iteration.
     fn history_csv(&self) -> String {
         let mut s = String::from(
-            "iteration,evaluations,photons,seconds,objective,objective_noise,noise_floor,area_cv,map_cv,thirteen_point,step",
+            "iteration,evaluations,photons,seconds,objective,objective_noise,noise_floor,area_cv,map_cv,thirteen_point,cv,delta_uv_13pt_debiased,step",
         );
         match &self.final_density {
             Density::Polynomial(c) => (0..c.len()).for_each(|k| {
@@ -50,7 +50,7 @@ impl OptimizeResult {
         for r in &self.history {
             let _ = write!(
                 s,
-                "{},{},{},{:.3},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{}",
+                "{},{},{},{:.3},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{}",
                 r.iteration,
                 r.evaluations,
                 r.photons,
@@ -61,6 +61,8 @@ impl OptimizeResult {
                 r.area_cv,
                 r.map_cv,
                 r.thirteen_point,
+                r.cv,
+                r.delta_uv_13pt_debiased,
                 r.step
             );
             for p in &r.params {

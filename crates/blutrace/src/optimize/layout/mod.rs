@@ -8,8 +8,8 @@
 //! ```
 //!
 //! - [`vary`]: `--vary KEY=MIN..MAX`, the dotted paths into the scene file.
-//! - [`objective`]: debiased area cv, 13-point ratio, efficiency or a weighted mix, with
-//!   jackknife errors.
+//! - [`objective`]: the `--objective` ([`crate::optimize::ObjectiveSpec`]: debiased area
+//!   cv, 13-point ratio, efficiency, colour Δu'v' or a weighted mix) with jackknife errors.
 //! - The search: integer variables (a row's `count`) are enumerated, and for each of their
 //!   combinations the continuous ones are searched by Nelder-Mead (the dots optimizer's,
 //!   in coordinates scaled to each variable's range, `--initial-step` and `--simplex-tol`
@@ -27,7 +27,7 @@ mod search;
 pub mod vary;
 mod write;
 
-pub use objective::{LayoutEvaluation, ObjectiveSpec};
+pub use objective::LayoutEvaluation;
 pub use result::{IntegerCase, LayoutResult, LayoutVerification, VariableResult, VerifiedLayout};
 pub use search::EvaluationRecord;
 pub use vary::{Variable, VarySpec};
@@ -57,6 +57,7 @@ pub fn optimize_layout(
     let doc: Value = scene.source().clone();
     let vars = resolve_variables(&doc, options)?;
     check_method(options, &vars)?;
+    options.objective.check(scene, true, options.method)?;
     if options.photons == 0 {
         bail!("option `photons` must be at least 1");
     }

@@ -1,8 +1,9 @@
 //! The state of one layout search: the scene file as a value tree, the variables, the
 //! traces so far and the best design.
 
-use super::objective::{LayoutEvaluation, ObjectiveSpec};
+use super::objective::{self, LayoutEvaluation};
 use super::vary::Variable;
+use crate::optimize::ObjectiveSpec;
 use crate::optimize::OptimizeOptions;
 use crate::optimize::design::Design;
 use crate::run::RunResult;
@@ -168,7 +169,7 @@ impl Design for LayoutSearch<'_> {
     }
 
     fn judge(&self, run: &RunResult) -> Result<LayoutEvaluation> {
-        Ok(self.objective.evaluate(run))
+        objective::evaluate(&self.objective, run)
     }
 
     fn builds(&self) -> &RefCell<MeshBuildCache> {

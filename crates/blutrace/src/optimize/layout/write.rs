@@ -60,7 +60,7 @@ impl LayoutResult {
         for v in &self.variables {
             let _ = write!(s, ",{}", v.name);
         }
-        s.push_str(",objective,objective_stderr,noise_floor,cv_debiased,cv_debiased_stderr,thirteen_point,thirteen_point_stderr,efficiency,efficiency_stderr,rejected\n");
+        s.push_str(",objective,objective_stderr,noise_floor,cv_debiased,cv_debiased_stderr,thirteen_point,thirteen_point_stderr,efficiency,efficiency_stderr,delta_uv_13pt_debiased,delta_uv_13pt_debiased_stderr,rejected\n");
         for r in &self.history {
             let _ = write!(s, "{},{},{:.3}", r.evaluation, r.photons, r.seconds);
             for v in &r.values {
@@ -70,7 +70,7 @@ impl LayoutResult {
                 Some(e) => {
                     let _ = write!(
                         s,
-                        ",{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},",
+                        ",{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},",
                         e.objective,
                         e.noise,
                         e.noise_floor,
@@ -79,10 +79,12 @@ impl LayoutResult {
                         e.thirteen_point,
                         e.thirteen_point_stderr,
                         e.efficiency,
-                        e.efficiency_stderr
+                        e.efficiency_stderr,
+                        e.delta_uv_13pt_debiased.unwrap_or(f64::NAN),
+                        e.delta_uv_13pt_debiased_stderr.unwrap_or(f64::NAN)
                     );
                 }
-                None => s.push_str(",,,,,,,,,"),
+                None => s.push_str(",,,,,,,,,,,"),
             }
             let reason = r.rejected.as_deref().unwrap_or("");
             let _ = writeln!(s, "\"{}\"", reason.replace('"', "'").replace('\n', " "));

@@ -8,7 +8,10 @@
 //! the 3x3-bin spots of the 13-point luminance check ([`super::thirteen_points`]);
 //! `delta_uv_13pt` is the largest Δu'v' of a spot from the whole target's chromaticity,
 //! `delta_uv_max` the largest between any two spots (the display-lab colour
-//! non-uniformity). Errors: delete-one-group jackknife over the run's photon groups, as
+//! non-uniformity). Being the largest of 13 noisy distances, `delta_uv_13pt` is biased up
+//! by the noise; `delta_uv_13pt_noise_floor` is what noise alone would give, and
+//! `delta_uv_13pt_debiased` removes it in quadrature ([`debiased`]), as `cv_debiased` does
+//! for the cv. Errors: delete-one-group jackknife over the run's photon groups, as
 //! for every non-linear metric ([`super::jackknife`]).
 
 use super::{Map, grid_map, jackknife_stderr, spot_mean, thirteen_points};
@@ -52,6 +55,13 @@ pub struct ColorSummary {
     pub duv: Estimate,
     /// Largest Δu'v' of a 13-point spot from the whole target's chromaticity.
     pub delta_uv_13pt: Estimate,
+    /// The `delta_uv_13pt` noise alone would give (each spot's offset drawn from its
+    /// jackknife covariance), over the spots lit in every photon group.
+    pub delta_uv_13pt_noise_floor: f64,
+    /// `sqrt(max(d² - floor², 0))`, `d` the largest Δu'v' of a spot lit in every group:
+    /// the colour spread with the noise removed; what the optimizer's colour objective
+    /// reads.
+    pub delta_uv_13pt_debiased: Estimate,
     /// Largest Δu'v' between any two of the 13 spots.
     pub delta_uv_max: Estimate,
     /// Mean illuminance over the target (lux).
@@ -61,8 +71,17 @@ pub struct ColorSummary {
     pub by_theta: Vec<[f64; 5]>,
 }
 
+/// Where [`values`] puts Δu'v' 13-point.
+const DELTA_UV_13PT: usize = 6;
+/// Where [`values`] puts the 13 spots' offsets from the target's chromaticity, (u', v')
+/// per spot (NaN for a spot without light).
+const SPOT_OFFSETS: usize = 9;
+/// Where [`values`] puts u', v' per theta row.
+const THETA_ROWS: usize = SPOT_OFFSETS + 2 * 13;
+
 /// The colour values of one tally (the total or a leave-one-out), in a fixed order:
-/// x, y, u', v', CCT, Duv, Δu'v' 13-point, Δu'v' max, mean Y, then u', v' per theta row.
+/// x, y, u', v', CCT, Duv, Δu'v' 13-point, Δu'v' max, mean Y, the 13 spots' u'v' offsets
+/// from the target's, then u', v' per theta row.
 fn values(scene: &Scene, color: &ColorTally, photons: u64) -> Vec<f64> {
     let mean = |g: &Grid| -> Vec<f64> {
         let n = photons.max(1) as f64;
@@ -78,8 +97,9 @@ fn values(scene: &Scene, color: &ColorTally, photons: u64) -> Vec<f64> {
     let (xy, uv) = (xyz.xy(), xyz.uv_prime());
     let c = uv.and_then(cct);
     let spots = spot_chromaticities(scene, &maps);
+    let lit: Vec<UvPrime> = spots.iter().flatten().copied().collect();
     let (d13, dmax) = match uv {
-        Some(uv) => spread(uv, &spots),
+        Some(uv) => spread(uv, &lit),
         None => (f64::NAN, f64::NAN),
     };
     let area_m2 = scene.detector.area_m2();
@@ -95,6 +115,10 @@ fn values(scene: &Scene, color: &ColorTally, photons: u64) -> Vec<f64> {
         dmax,
         lux,
     ];
+    v.extend(spots.iter().flat_map(|s| match (s, uv) {
+        (Some(s), Some(uv)) => [s.u - uv.u, s.v - uv.v],
+        _ => [f64::NAN; 2],
+    }));
     v.extend(theta_rows(color).into_iter().flat_map(|uv| match uv {
         Some(p) => [p.u, p.v],
         None => [f64::NAN; 2],
@@ -102,12 +126,12 @@ fn values(scene: &Scene, color: &ColorTally, photons: u64) -> Vec<f64> {
     v
 }
 
-/// The u'v' of each of the 13 spots that have light.
-fn spot_chromaticities(scene: &Scene, maps: &[Vec<f64>; 3]) -> Vec<UvPrime> {
+/// The u'v' of each of the 13 spots (`None` for a spot without light).
+fn spot_chromaticities(scene: &Scene, maps: &[Vec<f64>; 3]) -> Vec<Option<UvPrime>> {
     let [nx, ny] = scene.detector.bins;
     thirteen_points()
         .iter()
-        .filter_map(|&(fx, fy)| {
+        .map(|&(fx, fy)| {
             let s = |k: usize| spot_mean(nx, ny, &maps[k], fx, fy);
             Xyz {
                 x: s(0),
@@ -117,6 +141,113 @@ fn spot_chromaticities(scene: &Scene, maps: &[Vec<f64>; 3]) -> Vec<UvPrime> {
             .uv_prime()
         })
         .collect()
+}
+
+/// Draws of the noise-floor simulation ([`noise_floor`]): its own noise is then about 1 %
+/// of the floor.
+const FLOOR_DRAWS: u64 = 4096;
+
+/// The noise-floor simulation's seed.
+const FLOOR_SEED: u64 = 0xC010_F100;
+
+/// The spots' offsets from the target's chromaticity in `v` (a [`values`] vector).
+fn spot_offsets(v: &[f64]) -> impl Iterator<Item = [f64; 2]> + '_ {
+    (0..13).map(|i| [v[SPOT_OFFSETS + 2 * i], v[SPOT_OFFSETS + 2 * i + 1]])
+}
+
+/// The largest distance from the target's chromaticity in `v` among the spots `used`.
+fn largest_offset(v: &[f64], used: &[bool]) -> f64 {
+    spot_offsets(v)
+        .zip(used)
+        .filter(|(_, u)| **u)
+        .map(|([du, dv], _)| du.hypot(dv))
+        .fold(0.0, f64::max)
+}
+
+/// The Δu'v' 13-point that noise alone would give: the mean over [`FLOOR_DRAWS`] draws of
+/// the largest distance when each spot's offset is Gaussian with zero mean and its
+/// jackknife covariance (`cov` = [σ_u'², σ_v'², cov(u', v')] per spot). A fixed seed, so
+/// equal tallies give equal bits.
+fn noise_floor(cov: &[[f64; 3]]) -> f64 {
+    let mut rng = crate::rng::PhotonRng::new(FLOOR_SEED, 0);
+    let chol: Vec<[f64; 3]> = cov
+        .iter()
+        .map(|&[a, b, c]| {
+            let l11 = a.sqrt();
+            let l21 = if l11 > 0.0 { c / l11 } else { 0.0 };
+            [l11, l21, (b - l21 * l21).max(0.0).sqrt()]
+        })
+        .collect();
+    let mut sum = 0.0;
+    for _ in 0..FLOOR_DRAWS {
+        let mut largest = 0.0f64;
+        for [l11, l21, l22] in &chol {
+            // Box-Muller: two independent standard normals.
+            let r = (-2.0 * (1.0 - rng.uniform()).ln()).sqrt();
+            let (z1, z2) = (std::f64::consts::TAU * rng.uniform()).sin_cos();
+            let (g1, g2) = (r * z1, r * z2);
+            largest = largest.max((l11 * g1).hypot(l21 * g1 + l22 * g2));
+        }
+        sum += largest;
+    }
+    sum / FLOOR_DRAWS as f64
+}
+
+/// The jackknife covariance [σ_u'², σ_v'², cov] of each spot's offset over `leave_out`
+/// (NaN for a spot dark in some group).
+fn offset_covariances(leave_out: &[Vec<f64>]) -> Vec<[f64; 3]> {
+    let k = leave_out.len() as f64;
+    (0..13)
+        .map(|i| {
+            let col = |c: usize| -> Vec<f64> {
+                leave_out
+                    .iter()
+                    .map(|v| v[SPOT_OFFSETS + 2 * i + c])
+                    .collect()
+            };
+            let (u, v) = (col(0), col(1));
+            let mean = |x: &[f64]| x.iter().sum::<f64>() / k;
+            let (mu, mv) = (mean(&u), mean(&v));
+            let co = |x: &[f64], mx: f64, y: &[f64], my: f64| {
+                (k - 1.0) / k
+                    * x.iter()
+                        .zip(y)
+                        .map(|(a, b)| (a - mx) * (b - my))
+                        .sum::<f64>()
+            };
+            [co(&u, mu, &u, mu), co(&v, mv, &v, mv), co(&u, mu, &v, mv)]
+        })
+        .collect()
+}
+
+/// Δu'v' 13-point with the noise removed, as the cv is debiased: `sqrt(max(d² - f², 0))`,
+/// `d` the largest distance of a spot from the target's chromaticity and `f` its
+/// [`noise_floor`], over the spots lit in every group; its value for `own` and each
+/// leave-one-out (with the same floor), and the floor.
+fn debiased(own: &[f64], leave_out: &[Vec<f64>]) -> (f64, Vec<f64>, f64) {
+    let cov = offset_covariances(leave_out);
+    let used: Vec<bool> = cov
+        .iter()
+        .zip(spot_offsets(own))
+        .map(|(c, [du, dv])| c.iter().all(|x| x.is_finite()) && du.is_finite() && dv.is_finite())
+        .collect();
+    let lit: Vec<[f64; 3]> = cov
+        .iter()
+        .zip(&used)
+        .filter(|(_, u)| **u)
+        .map(|(c, _)| *c)
+        .collect();
+    let floor = if lit.is_empty() {
+        f64::NAN
+    } else {
+        noise_floor(&lit)
+    };
+    let debias = |v: &[f64]| {
+        let d = largest_offset(v, &used);
+        (d * d - floor * floor).max(0.0).sqrt()
+    };
+    let lo = leave_out.iter().map(|v| debias(v)).collect();
+    (debias(own), lo, floor)
 }
 
 /// The largest distance of a spot from `whole`, and between two spots.
@@ -150,13 +281,18 @@ fn theta_rows(color: &ColorTally) -> Vec<Option<UvPrime>> {
         .collect()
 }
 
-/// The colour summary of `total` with jackknife errors over `groups` (`None` for a
-/// monochrome run).
-pub fn color_summary(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<ColorSummary> {
+/// The colour [`values`] of `total`, and of `total` with each group that holds photons
+/// left out in turn (the order of [`super::Estimates::leave_out`]); `None` for a
+/// monochrome run.
+fn with_leave_out(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
     let color = total.color.as_ref()?;
     let n = total.ledger.photons;
     let own = values(scene, color, n);
-    let leave_out: Vec<Vec<f64>> = groups
+    let leave_out = groups
         .iter()
         .filter(|g| g.ledger.photons > 0)
         .filter_map(|g| {
@@ -165,6 +301,29 @@ pub fn color_summary(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<C
             Some(values(scene, &rest, n - g.ledger.photons))
         })
         .collect();
+    Some((own, leave_out))
+}
+
+/// Δu'v' 13-point debiased by the spots' noise ([`debiased_delta`]) of `total`, and its
+/// leave-one-out values over `groups` (in the order of [`super::Estimates::leave_out`], so
+/// a function of it and the flux metrics gets its jackknife error); `None` for a
+/// monochrome run.
+pub fn delta_uv_13pt_debiased(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+) -> Option<(f64, Vec<f64>)> {
+    let (own, leave_out) = with_leave_out(scene, total, groups)?;
+    let (value, lo, _) = debiased(&own, &leave_out);
+    Some((value, lo))
+}
+
+/// The colour summary of `total` with jackknife errors over `groups` (`None` for a
+/// monochrome run).
+pub fn color_summary(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<ColorSummary> {
+    let color = total.color.as_ref()?;
+    let (own, leave_out) = with_leave_out(scene, total, groups)?;
+    let duv = debiased(&own, &leave_out);
     let est = |i: usize| Estimate {
         value: own[i],
         stderr: jackknife_stderr(&leave_out.iter().map(|v| v[i]).collect::<Vec<_>>()),
@@ -172,7 +331,7 @@ pub fn color_summary(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<C
     let d = &scene.detector;
     let by_theta = (0..color.angular[0].nx)
         .map(|it| {
-            let (u, v) = (est(9 + 2 * it), est(10 + 2 * it));
+            let (u, v) = (est(THETA_ROWS + 2 * it), est(THETA_ROWS + 1 + 2 * it));
             [d.theta_centre_deg(it), u.value, u.stderr, v.value, v.stderr]
         })
         .collect();
@@ -183,7 +342,12 @@ pub fn color_summary(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<C
         v_prime: est(3),
         cct_k: est(4),
         duv: est(5),
-        delta_uv_13pt: est(6),
+        delta_uv_13pt: est(DELTA_UV_13PT),
+        delta_uv_13pt_debiased: Estimate {
+            value: duv.0,
+            stderr: jackknife_stderr(&duv.1),
+        },
+        delta_uv_13pt_noise_floor: duv.2,
         delta_uv_max: est(7),
         illuminance_lux: est(8),
         by_theta,

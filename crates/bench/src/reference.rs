@@ -99,6 +99,9 @@ use anyhow::Result;
 use blutrace::scene::Scene;
 use glam::Vec3;
 use rayon::prelude::*;
+use rng::{Rng, splitmix64};
+
+mod rng;
 
 /// Photons per work unit, as blutrace's.
 const CHUNK: u64 = 4096;
@@ -816,130 +819,5 @@ fn lambertian(k: usize, sign: f32, rng: &mut Rng) -> [f32; 3] {
     }
 }
 
-/// xoshiro128++ with a per-photon start.
-struct Rng([u32; 4]);
-
-impl Rng {
-    /// Photon `index`'s generator under `key`, SplitMix64 of the seed.
-    #[inline]
-    fn new(key: u64, index: u64) -> Self {
-        let a = splitmix64(key ^ index);
-        let b = splitmix64(a ^ 0xD1B5_4A32_D192_ED03);
-        let s = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32];
-        Rng(if s == [0; 4] { [1, 0, 0, 0] } else { s })
-    }
-
-    #[inline]
-    fn next_u32(&mut self) -> u32 {
-        let s = &mut self.0;
-        let out = s[0].wrapping_add(s[3]).rotate_left(7).wrapping_add(s[0]);
-        let t = s[1] << 9;
-        s[2] ^= s[0];
-        s[3] ^= s[1];
-        s[1] ^= s[2];
-        s[0] ^= s[3];
-        s[2] ^= t;
-        s[3] = s[3].rotate_left(11);
-        out
-    }
-
-    /// A uniform number in `[0, 1)` with 24 random bits.
-    #[inline]
-    fn uniform(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
-    }
-}
-
-/// SplitMix64's finalizer (Steele, Lea and Flood 2014): a bijective 64-bit mixer.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use std::path::Path;
-
-    fn bench_box() -> Scene {
-        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes/bench-box");
-        Scene::load(&dir.join("scene.toml")).unwrap()
-    }
-
-    #[test]
-    fn every_photon_has_one_fate_for_any_thread_count() {
-        let r = Reference::new(&bench_box()).unwrap();
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let three = rayon::ThreadPoolBuilder::new()
-            .num_threads(3)
-            .build()
-            .unwrap();
-        let a = one.install(|| r.trace(5, 20_000));
-        let b = three.install(|| r.trace(5, 20_000));
-        assert_eq!(a, b);
-        assert_eq!(a.fates(), 20_000);
-        assert_eq!(a.flux.iter().sum::<u64>(), a.detected);
-        assert!(a.detected > 0 && a.absorbed_by_ink > 0 && a.escaped > 0);
-    }
-
-    #[test]
-    fn reads_the_scene() {
-        let r = Reference::new(&bench_box()).unwrap();
-        let s = r.scene();
-        let size = s.hi - s.lo - Vec3::new(120.0, 80.0, 3.0);
-        assert!(size.abs().max_element() < 1e-4, "{size}");
-        assert_eq!((s.n_guide, s.n_air, s.absorption), (1.49, 1.0, 0.0003));
-        assert_eq!(
-            (s.dots.face, s.dots.pitch, s.dots.ink_albedo),
-            (4, 0.5, 0.9)
-        );
-        assert_eq!((s.sheet.axis, s.sheet_albedo), (2, 0.96));
-        assert_eq!(s.strip.body, Body::Lambert(0.8));
-        assert_eq!((s.target.bins, s.target.normal_sign), ([120, 80], 1.0));
-        // Dot radius at the lit edge: d = 0.05 + 0.2 u + 0.4 u^2 at u = 0.25 / 120.
-        let u = 0.25 / 120.0;
-        let d = 0.05 + 0.2 * u + 0.4 * u * u;
-        let r2 = s.dots.r2[(-s.dots.col0) as usize];
-        assert!((f64::from(r2) - d * 0.25 / std::f64::consts::PI).abs() < 1e-8);
-    }
-
-    #[test]
-    fn refuses_other_scenes_saying_why() {
-        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
-        for (scene, why) in [
-            ("notebook14", "square lattice"),
-            ("edge-holder", "more than one part"),
-            ("direct-lit", "scatters"),
-            ("test/slab", "no dotted face"),
-        ] {
-            let s = Scene::load(&dir.join(scene).join("scene.toml")).unwrap();
-            let e = Reference::new(&s).err().expect("refused").to_string();
-            assert!(
-                e.contains("box-guide scenes") && e.contains(why),
-                "{scene}: {e}"
-            );
-        }
-    }
-
-    #[test]
-    fn fresnel_matches_the_closed_form_at_normal_incidence() {
-        // R0 = ((n - 1)/(n + 1))^2: the share of reflections over many draws.
-        let mut rng = Rng::new(1, 2);
-        let n = 200_000;
-        let reflected = (0..n)
-            .filter(|_| Interface::new(1.0, 1.49).refract(1.0, &mut rng).is_none())
-            .count();
-        let r0 = (0.49f64 / 2.49).powi(2);
-        let se = (r0 * (1.0 - r0) / n as f64).sqrt();
-        assert!((reflected as f64 / n as f64 - r0).abs() < 4.0 * se);
-        assert!(
-            Interface::new(1.49, 1.0).refract(0.5, &mut rng).is_none(),
-            "beyond critical"
-        );
-    }
-}
+mod tests;

@@ -43,6 +43,7 @@ fn section(
         .collect();
     Section {
         scatter,
+        channel: None,
         plane_symmetric,
         rotations: vec![0.0],
         aoi: aoi.to_vec(),
@@ -222,6 +223,47 @@ fn a_lambertian_table_traces_like_lambert_in_a_scene() {
     );
 }
 
+/// An XYZ file whose channels are Lambertian tables of albedo `x`, `y`, `z`.
+fn lambert_xyz(x: f64, y: f64, z: f64) -> String {
+    let mut out = String::new();
+    for (k, albedo) in [("X", x), ("Y", y), ("Z", z)] {
+        let t = lambert_table(albedo);
+        let (head, data) = t.split_once("\nMonochrome\n").unwrap();
+        if out.is_empty() {
+            out = head.replace("SpectralContent  Monochrome", "SpectralContent  XYZ") + "\n";
+        }
+        out.push_str(&format!("Tristimulus{k}\n{data}"));
+    }
+    out
+}
+
+/// The channel an XYZ file's `tristimulus` picks traces as that channel's table.
+#[test]
+fn an_xyz_tables_channel_traces_like_its_table() {
+    let table = lambert_xyz(0.3, 0.7, 0.5);
+    let detected =
+        |r: &RunResult| r.tally.ledger.detected.sum.value() / r.tally.ledger.photons as f64;
+    for (k, albedo) in [("Y", 0.7), ("X", 0.3)] {
+        let t = sheet_run(
+            &format!("xyz-{k}"),
+            &format!("model = \"bsdf_table\"\nfile = \"l.bsdf\"\ntristimulus = \"{k}\""),
+            &[("l.bsdf", &table)],
+        );
+        let l = sheet_run(
+            &format!("xyz-lambert-{k}"),
+            &format!("model = \"lambert\"\nalbedo = {albedo}"),
+            &[],
+        );
+        let n = t.tally.ledger.photons as f64;
+        let (dt, dl) = (detected(&t), detected(&l));
+        let sigma = (dt * (1.0 - dt) / n + dl * (1.0 - dl) / n).sqrt();
+        assert!(
+            (dt - dl).abs() < 3.0 * sigma,
+            "{k}: table {dt} vs lambert {dl} (sigma {sigma})"
+        );
+    }
+}
+
 /// The cell edges of nodes (degrees -> radians) as the module documents them.
 fn edges(nodes: &[f64], last: f64) -> Vec<f64> {
     let mut e = vec![0.0];
@@ -368,6 +410,23 @@ fn the_loader_names_the_file_the_field_and_the_line() {
         e.contains("t.bsdf: line ") && e.contains("no value of it lies above the surface"),
         "{e}"
     );
+    // XYZ files need their channel named, and only they take one.
+    let xyz = lambert_xyz(0.3, 0.7, 0.5);
+    let e = err(base, &[("t.bsdf", &xyz)]);
+    assert!(
+        e.contains("surfaces.film.tristimulus") && e.contains("holds XYZ"),
+        "{e}"
+    );
+    let e = err(
+        &format!("{base}\ntristimulus = \"Y\""),
+        &[("t.bsdf", &good)],
+    );
+    assert!(
+        e.contains("surfaces.film.tristimulus") && e.contains("is Monochrome"),
+        "{e}"
+    );
+    let e = err(&format!("{base}\ntristimulus = \"W\""), &[("t.bsdf", &xyz)]);
+    assert!(e.contains("W") && e.contains("X"), "{e}");
     // An unknown key, and a u_axis along the face's normal (checked against the face).
     let e = err(&format!("{base}\ncolour = 1"), &[("t.bsdf", &good)]);
     assert!(e.contains("colour"), "{e}");

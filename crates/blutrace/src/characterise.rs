@@ -390,6 +390,7 @@ pub fn characterise(scene: &Scene, opts: &Options) -> Result<Characterised> {
         }
     }
     let section = |scatter, blocks| Section {
+        channel: None,
         scatter,
         plane_symmetric: symmetric,
         rotations: opts.rotations_deg.clone(),

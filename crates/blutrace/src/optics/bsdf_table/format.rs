@@ -30,6 +30,11 @@
 //! A file may hold several such sections one after the other (blutrace writes a BRDF and
 //! a BTDF section in one file; other tools write one section per file). Values may wrap
 //! over lines: numbers are read in order, each remembered with its line.
+//!
+//! `SpectralContent XYZ` sections hold three tables on the one grid, the BSDF weighted by
+//! the CIE x̄, ȳ and z̄ functions: after the angles, `TristimulusX`, `TristimulusY` and
+//! `TristimulusZ` each followed by its own `DataBegin` ... `DataEnd` (in any order, each
+//! once). They are read as three sections, one per [`Channel`].
 
 use anyhow::{Result, bail};
 use std::fmt::Write as _;
@@ -54,11 +59,37 @@ impl ScatterType {
     }
 }
 
+/// A tristimulus channel of an XYZ table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+pub enum Channel {
+    /// The x̄-weighted table.
+    X,
+    /// The ȳ-weighted (photopic) table.
+    Y,
+    /// The z̄-weighted table.
+    Z,
+}
+
+impl Channel {
+    const ALL: [Channel; 3] = [Channel::X, Channel::Y, Channel::Z];
+
+    /// The data's indicator in the file.
+    pub fn indicator(self) -> &'static str {
+        match self {
+            Channel::X => "TristimulusX",
+            Channel::Y => "TristimulusY",
+            Channel::Z => "TristimulusZ",
+        }
+    }
+}
+
 /// One section of a file: one scatter type on one grid, all angles in degrees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Section {
     /// BRDF or BTDF.
     pub scatter: ScatterType,
+    /// The tristimulus channel of an XYZ file (`None`: Monochrome).
+    pub channel: Option<Channel>,
     /// `PlaneSymmetrical`: the azimuths cover 0..=180 and the other half mirrors them.
     pub plane_symmetric: bool,
     /// Sample rotations (degrees).
@@ -213,7 +244,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Section>> {
     let mut words = Words::new(text, path);
     let mut sections = Vec::new();
     while !words.at_end() {
-        sections.push(section(&mut words)?);
+        sections.extend(section(&mut words)?);
     }
     if sections.is_empty() {
         bail!("{}: holds no BSDF data (no Source line)", path.display());
@@ -221,8 +252,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Section>> {
     Ok(sections)
 }
 
-fn section(w: &mut Words) -> Result<Section> {
-    w.keyed("Source")?;
+/// One section of the file: one table, or three for an XYZ file.
+fn section(w: &mut Words) -> Result<Vec<Section>> {
+    w.keyword("Source")?;
+    w.word("the value of Source")?;
     let sym = w.keyed("Symmetry")?;
     let plane_symmetric = match sym.text.to_ascii_lowercase().as_str() {
         "planesymmetrical" => true,
@@ -237,8 +270,20 @@ fn section(w: &mut Words) -> Result<Section> {
             ));
         }
     };
-    let spectral = w.keyed("SpectralContent")?;
-    monochrome(w, spectral)?;
+    let content = w.keyed("SpectralContent")?;
+    let xyz = match content.text.to_ascii_lowercase().as_str() {
+        "monochrome" => false,
+        "xyz" => true,
+        _ => {
+            return Err(w.err_at(
+                content.line,
+                format!(
+                    "SpectralContent: expected Monochrome or XYZ, found {:?}",
+                    content.text
+                ),
+            ));
+        }
+    };
     let st = w.keyed("ScatterType")?;
     let scatter = match st.text.to_ascii_uppercase().as_str() {
         "BRDF" => ScatterType::Brdf,
@@ -255,13 +300,62 @@ fn section(w: &mut Words) -> Result<Section> {
     let az_max = if plane_symmetric { 180.0 } else { 360.0 };
     let azimuth = w.angles("ScatterAzimuth", (0.0, az_max, !plane_symmetric))?;
     let radial = w.angles("ScatterRadial", (0.0, 180.0, false))?;
-    let indicator = w.word("the spectral content indicator (Monochrome)")?;
-    monochrome(w, indicator)?;
+    let grid = Section {
+        scatter,
+        channel: None,
+        plane_symmetric,
+        rotations,
+        aoi,
+        azimuth,
+        radial,
+        blocks: Vec::new(),
+    };
+    if !xyz {
+        let indicator = w.word("the spectral content indicator (Monochrome)")?;
+        if !indicator.text.eq_ignore_ascii_case("Monochrome") {
+            return Err(w.err_at(
+                indicator.line,
+                format!(
+                    "expected Monochrome (the SpectralContent), found {:?}",
+                    indicator.text
+                ),
+            ));
+        }
+        return Ok(vec![data(w, grid)?]);
+    }
+    let mut out: Vec<Section> = Vec::with_capacity(3);
+    for _ in 0..3 {
+        let indicator = w.word("TristimulusX, TristimulusY or TristimulusZ")?;
+        let channel = Channel::ALL
+            .into_iter()
+            .find(|c| indicator.text.eq_ignore_ascii_case(c.indicator()))
+            .filter(|c| out.iter().all(|s| s.channel != Some(*c)))
+            .ok_or_else(|| {
+                w.err_at(
+                    indicator.line,
+                    format!(
+                        "an XYZ table needs TristimulusX, TristimulusY and TristimulusZ data, each once; found {:?}",
+                        indicator.text
+                    ),
+                )
+            })?;
+        let table = Section {
+            channel: Some(channel),
+            ..grid.clone()
+        };
+        out.push(data(w, table)?);
+    }
+    Ok(out)
+}
+
+/// The `DataBegin` ... `DataEnd` of `sec`'s grid: its blocks.
+fn data(w: &mut Words, mut sec: Section) -> Result<Section> {
     w.keyword("DataBegin")?;
-    let mut blocks = Vec::with_capacity(rotations.len() * aoi.len());
-    for r in &rotations {
-        for a in &aoi {
-            blocks.push(block(w, (*r, *a), azimuth.len(), radial.len())?);
+    let n = sec.rotations.len() * sec.aoi.len();
+    for r in &sec.rotations {
+        for a in &sec.aoi {
+            let b = block(w, (*r, *a), sec.azimuth.len(), sec.radial.len())?;
+            sec.blocks.push(b);
         }
     }
     let end = w.word("DataEnd")?;
@@ -269,36 +363,14 @@ fn section(w: &mut Words) -> Result<Section> {
         return Err(w.err_at(
             end.line,
             format!(
-                "expected DataEnd after {} blocks of {} x {} values, found {:?}",
-                blocks.len(),
-                azimuth.len(),
-                radial.len(),
+                "expected DataEnd after {n} blocks of {} x {} values, found {:?}",
+                sec.azimuth.len(),
+                sec.radial.len(),
                 end.text
             ),
         ));
     }
-    Ok(Section {
-        scatter,
-        plane_symmetric,
-        rotations,
-        aoi,
-        azimuth,
-        radial,
-        blocks,
-    })
-}
-
-fn monochrome(w: &Words, word: Word) -> Result<()> {
-    if word.text.eq_ignore_ascii_case("Monochrome") {
-        return Ok(());
-    }
-    Err(w.err_at(
-        word.line,
-        format!(
-            "spectral content {:?} is not read: blutrace reads Monochrome tables",
-            word.text
-        ),
-    ))
+    Ok(sec)
 }
 
 fn block(w: &mut Words, (rot, aoi): (f64, f64), n_az: usize, n_rad: usize) -> Result<Block> {
@@ -330,7 +402,8 @@ fn block(w: &mut Words, (rot, aoi): (f64, f64), n_az: usize, n_rad: usize) -> Re
     Ok(Block { tis, line, values })
 }
 
-/// The text of `sections` in the IS BSDF format, after `comments` (one `#` line each).
+/// The text of `sections` in the IS BSDF format, after `comments` (one `#` line each),
+/// each section as a Monochrome table (a channel of an XYZ file as the table it is).
 pub fn write(sections: &[Section], comments: &[String]) -> String {
     let mut s = String::new();
     let list = |v: &[f64]| {
@@ -409,6 +482,47 @@ mod tests {
         );
     }
 
+    /// `GOOD` as an XYZ file: its data three times, X's values scaled by `kx`.
+    fn xyz(kx: f64, order: [&str; 3]) -> String {
+        let (head, data) = GOOD.split_once("\nMonochrome\n").unwrap();
+        let head = head.replace("SpectralContent  Monochrome", "SpectralContent  XYZ");
+        let x = data.replace("TIS 0.5", &format!("TIS {}", 0.5 * kx));
+        let mut s = head + "\n";
+        for c in order {
+            s.push_str(&format!(
+                "{c}\n{}",
+                if c == "TristimulusX" { &x } else { data }
+            ));
+        }
+        s
+    }
+
+    #[test]
+    fn an_xyz_table_reads_as_three_channels() {
+        let s = parse(
+            &xyz(0.5, ["TristimulusZ", "TristimulusX", "TristimulusY"]),
+            Path::new("t.bsdf"),
+        )
+        .unwrap();
+        let got: Vec<(Option<Channel>, f64)> =
+            s.iter().map(|c| (c.channel, c.blocks[0].tis)).collect();
+        assert_eq!(
+            got,
+            [
+                (Some(Channel::Z), 0.5),
+                (Some(Channel::X), 0.25),
+                (Some(Channel::Y), 0.5)
+            ]
+        );
+        assert!(
+            s.iter()
+                .all(|c| c.aoi == [0.0, 60.0] && c.blocks.len() == 2)
+        );
+        let twice = xyz(1.0, ["TristimulusX", "TristimulusX", "TristimulusY"]);
+        let e = err(&twice);
+        assert!(e.contains("line 24:") && e.contains("each once"), "{e}");
+    }
+
     #[test]
     fn every_error_names_the_file_and_the_line() {
         let cases = [
@@ -421,8 +535,12 @@ mod tests {
                 "line 3: Symmetry",
             ),
             (
+                GOOD.replace("SpectralContent  Monochrome", "SpectralContent  RGB"),
+                "line 4: SpectralContent: expected Monochrome or XYZ",
+            ),
+            (
                 GOOD.replace("SpectralContent  Monochrome", "SpectralContent  XYZ"),
-                "line 4:",
+                "line 15: an XYZ table needs TristimulusX, TristimulusY and TristimulusZ",
             ),
             (
                 GOOD.replace("ScatterType  BRDF", "ScatterType  BXDF"),

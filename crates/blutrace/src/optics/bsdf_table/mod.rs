@@ -9,6 +9,7 @@
 //! inside = "air"           # with a BTDF: the medium behind the face (as dielectric's)
 //! outside = "air"          # default "air"
 //! u_axis = [1.0, 0.0, 0.0] # optional: the direction of sample rotation 0 on the face
+//! tristimulus = "Y"        # XYZ files: the channel to trace (X, Y or Z)
 //! ```
 //!
 //! The files hold at most one BRDF and one BTDF section. A photon arriving at the
@@ -28,7 +29,14 @@
 //! node's place to the next: such tables need a fine AOI grid. Sample rotations (the orientation of the plane of incidence on
 //! the face, measured from `u_axis` towards `normal x u_axis`) take the nearest block;
 //! `u_axis` defaults to the world x axis projected onto the face (the y axis where the
-//! face's normal is within 26 degrees of x). Monochrome tables only.
+//! face's normal is within 26 degrees of x).
+//!
+//! Monochrome and XYZ (tristimulus) files. An XYZ file holds the BSDF weighted by x̄, ȳ
+//! and z̄; `tristimulus` picks the one to trace at every wavelength (as OpticStudio's
+//! table model does): `"Y"` is the photopic table, what a luminance meter sees. A stand-in
+//! for a spectral BSDF: three weighted means cannot give the table at each wavelength,
+//! so a film's colour (a yellowish sheet's lower Z) is not traced; trace the channels in
+//! turn to see how much it matters.
 //!
 //! What a table leaves out: where the light leaves (a part's lateral spread: light
 //! enters and leaves at one point), polarisation, coherence, and any difference between
@@ -42,7 +50,7 @@ use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::{Result, bail};
-use format::{ScatterType, Section};
+use format::{Channel, ScatterType, Section};
 use glam::DVec3;
 use sample::{BlockSampler, Frame, Grid, Incidence};
 use serde::{Deserialize, Serialize};
@@ -84,6 +92,9 @@ pub struct BsdfTableSpec {
     /// The direction of sample rotation 0 on the face.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub u_axis: Option<[f64; 3]>,
+    /// XYZ files: the tristimulus channel to trace.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tristimulus: Option<Channel>,
 }
 
 /// One scatter type's table, ready to sample.
@@ -269,7 +280,7 @@ impl SurfaceSpecOf for BsdfTableSpec {
         if files.is_empty() {
             return Err(ctx.err(&field, "names no file"));
         }
-        let (brdf, btdf) = read_tables(ctx, &field, dir, &files)?;
+        let (brdf, btdf) = read_tables(ctx, (&field, at), dir, &files, self.tristimulus)?;
         check_sum(ctx, &field, brdf.as_ref(), btdf.as_ref())?;
         let interface = match (&self.inside, &btdf) {
             (Some(inside), _) => Some(Interface::build(ctx, at, inside, &self.outside, media)?),
@@ -304,14 +315,24 @@ impl SurfaceSpecOf for BsdfTableSpec {
 /// A table and the file it came from.
 type Loaded = Option<(PathBuf, Arc<Table>)>;
 
-/// Read `files` (relative to `dir`; `field` names them in errors): the BRDF and the BTDF.
-fn read_tables(ctx: &Ctx, field: &str, dir: &Path, files: &[PathBuf]) -> Result<(Loaded, Loaded)> {
+/// Read `files` (relative to `dir`; `field` names them in errors, `at` the surface): the
+/// BRDF and the BTDF, of channel `channel` in XYZ files.
+fn read_tables(
+    ctx: &Ctx,
+    (field, at): (&str, &str),
+    dir: &Path,
+    files: &[PathBuf],
+    channel: Option<Channel>,
+) -> Result<(Loaded, Loaded)> {
     let (mut brdf, mut btdf): (Loaded, Loaded) = (None, None);
     for f in files {
         let path = dir.join(f);
         let text = crate::input_file::read_text(&path, "BSDF table")
             .map_err(|e| ctx.err(field, format!("{e:#}")))?;
         for sec in format::parse(&text, &path)? {
+            if !traced_channel(ctx, at, &path, sec.channel, channel)? {
+                continue;
+            }
             let slot = match sec.scatter {
                 ScatterType::Brdf => &mut brdf,
                 ScatterType::Btdf => &mut btdf,
@@ -331,6 +352,35 @@ fn read_tables(ctx: &Ctx, field: &str, dir: &Path, files: &[PathBuf]) -> Result<
         }
     }
     Ok((brdf, btdf))
+}
+
+/// Whether a section of `path` holding `found` (`None`: Monochrome) is traced when the
+/// scene asks for `wanted`; an error when the two do not go together.
+fn traced_channel(
+    ctx: &Ctx,
+    at: &str,
+    path: &Path,
+    found: Option<Channel>,
+    wanted: Option<Channel>,
+) -> Result<bool> {
+    match (found, wanted) {
+        (None, None) => Ok(true),
+        (Some(f), Some(w)) => Ok(f == w),
+        (Some(_), None) => Err(ctx.err(
+            &format!("{at}.tristimulus"),
+            format!(
+                "{} holds XYZ (tristimulus) tables: say which to trace, tristimulus = \"X\", \"Y\" (photopic) or \"Z\"",
+                path.display()
+            ),
+        )),
+        (None, Some(_)) => Err(ctx.err(
+            &format!("{at}.tristimulus"),
+            format!(
+                "is for XYZ files, and {} is Monochrome",
+                path.display()
+            ),
+        )),
+    }
 }
 
 /// The reflected and transmitted TIS may not add up to more than 1 at any of either

@@ -111,3 +111,37 @@ fn cones_are_checked_and_a_run_without_lumens_has_no_map() {
     let run = trace(&load(&write_scene("lum-none", toml, &[])), 1000, 1, 1);
     assert!(run.tally.cone.is_none() && run.summary().luminance_map.is_none());
 }
+
+/// `trace --luminance-cone-deg` replaces the scene's cone, is checked, and is refused with
+/// `--shard` (shards and their merge must share one cone: the scene file's).
+#[test]
+fn the_command_lines_cone_replaces_the_scenes_and_is_checked() {
+    let dir = temp_folder("lum-cli");
+    let out = dir.path().join("out");
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"))
+            .args(["trace", "scenes/phone-led", "--photons", "20000", "--quiet"])
+            .args(["--out", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert!(run(&["--luminance-cone-deg", "10"]).status.success());
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(s["luminance_map"]["cone_deg"], 10.0);
+    for (extra, says) in [
+        (
+            &["--luminance-cone-deg", "95"][..],
+            "--luminance-cone-deg must be within (0, 90]",
+        ),
+        (
+            &["--luminance-cone-deg", "5", "--shard", "0/2"][..],
+            "cannot be given with --shard",
+        ),
+    ] {
+        let bad = run(extra);
+        let e = String::from_utf8_lossy(&bad.stderr);
+        assert!(!bad.status.success() && e.contains(says), "{e}");
+    }
+}

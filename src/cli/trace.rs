@@ -3,7 +3,7 @@
 
 use super::enums;
 use super::{default_out, scene_path, word};
-use anyhow::Result;
+use anyhow::{Result, bail};
 use blutrace::accel::BackendChoice;
 use blutrace::estimator::Estimator;
 use blutrace::output::atomic::{check_apart, check_dest};
@@ -54,6 +54,11 @@ pub(super) struct TraceArgs {
     /// Do not use the convex-solid fast path (every ray goes through the backend).
     #[arg(long)]
     no_convex: bool,
+    /// Half-angle (degrees) of the luminance map's cone about the detector normal,
+    /// instead of the scene's detector.luminance_cone_deg (default 2, a luminance meter's
+    /// acceptance). Not with --shard: set it in the scene file, so shards and merge agree.
+    #[arg(long, value_parser = blutrace::count::parse_finite)]
+    luminance_cone_deg: Option<f64>,
 }
 
 #[derive(clap::Args)]
@@ -76,7 +81,18 @@ pub(super) struct MergeArgs {
 pub(super) fn trace(args: TraceArgs, quiet: bool) -> Result<ExitCode> {
     // First, so an interrupt while the scene loads is one too.
     let interrupt = super::stop_on_signals();
-    let scene = Scene::load(&scene_path(&args.scene))?;
+    let mut scene = Scene::load(&scene_path(&args.scene))?;
+    if let Some(cone) = args.luminance_cone_deg {
+        if args.shard.is_some() {
+            bail!(
+                "option `luminance_cone_deg` cannot be given with option `shard`: set detector.luminance_cone_deg in the scene file, so every shard and the merge use the same cone"
+            );
+        }
+        scene
+            .detector
+            .set_luminance_cone(cone)
+            .map_err(|e| anyhow::anyhow!("option `luminance_cone_deg` {e}"))?;
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

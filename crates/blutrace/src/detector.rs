@@ -87,12 +87,7 @@ impl DetectorSpec {
             }
         }
         let cone = d.luminance_cone_deg;
-        if !(cone > 0.0 && cone <= 90.0) {
-            return Err(ctx.err(
-                "detector.luminance_cone_deg",
-                format!("must be within (0, 90] degrees, got {cone}"),
-            ));
-        }
+        check_cone(cone).map_err(|e| ctx.err("detector.luminance_cone_deg", e))?;
         Ok(TargetPlane {
             luminance_cone_deg: cone,
             cone_cos: cone.to_radians().cos(),
@@ -106,6 +101,14 @@ impl DetectorSpec {
             bins: d.bins,
             angular_bins: d.angular_bins,
         })
+    }
+}
+
+/// A luminance cone's half-angle (degrees) must lie within (0, 90].
+fn check_cone(deg: f64) -> Result<(), String> {
+    match deg > 0.0 && deg <= 90.0 {
+        true => Ok(()),
+        false => Err(format!("must be within (0, 90] degrees, got {deg}")),
     }
 }
 
@@ -134,6 +137,14 @@ impl TargetPlane {
     /// Unit normal: the direction photons are detected travelling along.
     pub fn normal(&self) -> DVec3 {
         self.u.cross(self.v)
+    }
+
+    /// Set the luminance cone's half-angle to `deg` degrees, or say why not.
+    pub fn set_luminance_cone(&mut self, deg: f64) -> Result<(), String> {
+        check_cone(deg)?;
+        self.luminance_cone_deg = deg;
+        self.cone_cos = deg.to_radians().cos();
+        Ok(())
     }
 
     /// Whether a detected direction lies within the luminance cone.

@@ -66,8 +66,9 @@ fn a_bad_scene_names_file_and_field_and_writes_nothing() {
 }
 
 /// The files of a complete trace output set.
-const OUTPUTS: [&str; 6] = [
+const OUTPUTS: [&str; 7] = [
     "angular.exr",
+    "conoscope.png",
     "convergence.csv",
     "convergence.png",
     "flux.exr",

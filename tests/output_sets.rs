@@ -13,12 +13,13 @@ use std::process::{Command, Stdio};
 
 const SCENE: &str = "scenes/test/slab";
 /// The outputs whose bytes depend only on scene, seed and photons (not on timings).
-const DETERMINISTIC: [&str; 3] = ["flux.exr", "angular.exr", "flux.png"];
+const DETERMINISTIC: [&str; 4] = ["flux.exr", "angular.exr", "flux.png", "conoscope.png"];
 /// The steps of writing a run's output set, in order, as the test hook names them.
-const STEPS: [&str; 8] = [
+const STEPS: [&str; 9] = [
     "wrote flux.exr",
     "wrote angular.exr",
     "wrote flux.png",
+    "wrote conoscope.png",
     "wrote convergence.csv",
     "wrote convergence.png",
     "wrote summary.json",

@@ -95,7 +95,7 @@ fn four_shards_merge_to_the_single_run_bit_for_bit() {
     args.extend(["--out", merged.to_str().unwrap()]);
     ok(&args);
     // The images, byte for byte.
-    for f in ["flux.exr", "angular.exr", "flux.png"] {
+    for f in ["flux.exr", "angular.exr", "flux.png", "conoscope.png"] {
         let bytes = |d: &Path| std::fs::read(d.join(f)).unwrap();
         assert!(
             bytes(&single) == bytes(&merged),

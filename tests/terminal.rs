@@ -95,6 +95,7 @@ fn ctrl_c_writes_what_was_traced_and_exits_130() {
         "flux.exr",
         "angular.exr",
         "flux.png",
+        "conoscope.png",
         "convergence.csv",
         "convergence.png",
     ] {

@@ -140,7 +140,8 @@ impl Run {
     }
 
     /// Write the command line's output set (`flux.exr`, `angular.exr`, `flux.png`,
-    /// `convergence.csv`, `convergence.png`, `summary.json`) into `dir`, all or nothing;
+    /// `conoscope.png`, `convergence.csv`, `convergence.png`, `summary.json`, and the
+    /// colour images of a spectral scene) into `dir`, all or nothing;
     /// returns the files written.
     fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<String>> {
         let run = self.inner.clone();

@@ -59,11 +59,11 @@ def test_outputs_equal_the_command_lines_byte_for_byte(cli, box, run, tmp_path):
     mine = tmp_path / "py"
     files = run.write(mine)
     assert sorted(p.split("/")[-1] for p in files) == sorted(
-        ["flux.exr", "angular.exr", "flux.png", "convergence.csv", "convergence.png", "summary.json"]
+        ["flux.exr", "angular.exr", "flux.png", "conoscope.png", "convergence.csv", "convergence.png", "summary.json"]
     )
     theirs = tmp_path / "cli"
     run_cli(cli, "trace", box.path, "--photons", str(N), "--seed", "3", "--quiet", "--out", str(theirs))
-    for name in ["flux.exr", "angular.exr", "flux.png"]:
+    for name in ["flux.exr", "angular.exr", "flux.png", "conoscope.png"]:
         assert (mine / name).read_bytes() == (theirs / name).read_bytes(), name
     timing = {"runtime_s", "photons_per_s", "interactions_per_s", "figure_of_merit", "threads"}
     a, b = (json.loads((d / "summary.json").read_text()) for d in (mine, theirs))

@@ -269,6 +269,14 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         l.roulette_w,
         l.balance_rel_error
     );
+    if l.detected_by_source_w.len() > 1 {
+        let parts: Vec<String> = l
+            .detected_by_source_w
+            .iter()
+            .map(|d| format!("{} {:.4} ± {:.4}", d.source, d.w, d.stderr_w))
+            .collect();
+        say!("by source  detected W: {}", parts.join(", "));
+    }
     say!(
         "efficiency {:.4} ± {:.4} of the emitted power reaches the target",
         s.extraction_efficiency,

@@ -27,8 +27,9 @@ use std::path::{Path, PathBuf};
 pub const SHARD_FILE: &str = "shard.json";
 const FORMAT: &str = "blutrace-shard";
 /// 2: the ledger books lamp bodies (`absorbed_by_source`) and counts hits per tag
-/// (`hits_by_tag`, `feature_hits_by_tag`).
-const FORMAT_VERSION: u32 = 2;
+/// (`hits_by_tag`, `feature_hits_by_tag`); 3: and the detections per source
+/// (`detected_by_source`).
+const FORMAT_VERSION: u32 = 3;
 
 /// A shard's raw tallies and what identifies the run it belongs to.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -289,6 +289,11 @@ pub struct Ledger {
     pub emitted: ExactSum,
     /// Weight detected on the target (sum and sum of squares per photon).
     pub detected: BinStats,
+    /// Weight detected on the target per source, in source order: the photon loop books
+    /// each detection to its source's bin, and `detected` is their sum, so they add up to
+    /// it exactly (sums, sums of squares and counts).
+    #[serde(default)]
+    pub detected_by_source: Vec<BinStats>,
     /// Weight absorbed per surface tag.
     pub absorbed_by_surface: Vec<ExactSum>,
     /// Weight absorbed per medium.
@@ -314,13 +319,16 @@ impl Ledger {
             absorbed_by_surface: vec![ExactSum::default(); tags],
             absorbed_in_medium: vec![ExactSum::default(); media],
             absorbed_by_source: vec![ExactSum::default(); sources],
+            detected_by_source: vec![BinStats::default(); sources],
             ..Default::default()
         }
     }
 
-    pub(crate) fn end(&mut self, fate: Fate, w: f64) {
+    /// Book the end of a photon of weight `w` emitted by source `source`.
+    pub(crate) fn end(&mut self, fate: Fate, w: f64, source: usize) {
         match fate {
-            Fate::Detected => self.detected.add(w),
+            // Booked to its source only: `detected` is their sum ([`Ledger::sum_detected`]).
+            Fate::Detected => self.detected_by_source[source].add(w),
             Fate::AbsorbedBySurface(t) => self.absorbed_by_surface[t as usize].add(w),
             Fate::AbsorbedInMedium(m) => self.absorbed_in_medium[m as usize].add(w),
             Fate::AbsorbedBySource(i) => self.absorbed_by_source[i as usize].add(w),
@@ -331,6 +339,15 @@ impl Ledger {
             }
             Fate::Roulette => self.roulette.add(w),
         }
+    }
+
+    /// Set `detected` to the sum of the per-source detections (exact: integer sums), once
+    /// the photons [`Ledger::end`] booked are all traced: the photon loop then pays for one
+    /// bin per detection, as it did before detections were kept per source.
+    pub(crate) fn sum_detected(&mut self) {
+        let mut total = BinStats::default();
+        self.detected_by_source.iter().for_each(|b| total.merge(b));
+        self.detected = total;
     }
 
     /// Count one surface interaction on tag `tag`, which met the tag's pattern (ink, a
@@ -406,9 +423,15 @@ impl Ledger {
             }
         }
         weight(&mut self.emitted, o.emitted)?;
-        weight(&mut self.detected.sum, o.detected.sum)?;
-        weight(&mut self.detected.sumsq, o.detected.sumsq)?;
-        count(&mut self.detected.hits, o.detected.hits)?;
+        for (a, b) in std::iter::once((&mut self.detected, &o.detected)).chain(
+            self.detected_by_source
+                .iter_mut()
+                .zip(&o.detected_by_source),
+        ) {
+            weight(&mut a.sum, b.sum)?;
+            weight(&mut a.sumsq, b.sumsq)?;
+            count(&mut a.hits, b.hits)?;
+        }
         for (mine, theirs) in [
             (&mut self.absorbed_by_surface, &o.absorbed_by_surface),
             (&mut self.absorbed_in_medium, &o.absorbed_in_medium),
@@ -495,17 +518,29 @@ impl Tally {
                     l.feature_hits_by_tag.len(),
                     l.absorbed_by_surface.len(),
                 ),
-                (l.absorbed_in_medium.len(), l.absorbed_by_source.len(), 0),
+                (
+                    l.absorbed_in_medium.len(),
+                    l.absorbed_by_source.len(),
+                    l.detected_by_source.len(),
+                ),
             ]
             .into_iter()
             .chain(t.color.iter().flat_map(ColorTally::shape))
             .collect::<Vec<_>>()
         };
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
+        let by_source = l.detected_by_source.iter();
         let negative = sinks
             .chain(&l.absorbed_by_source)
             .chain([&l.escaped, &l.killed, &l.detected.sum, &l.detected.sumsq])
+            .chain(by_source.clone().flat_map(|b| [&b.sum, &b.sumsq]))
             .any(|s| s.0 < 0);
+        // The per-source detections add up to the detections exactly, or `None` past
+        // the counters' range.
+        let by_source_total = by_source.clone().try_fold(BinStats::default(), |mut t, b| {
+            t.checked_merge(b)?;
+            Some(t)
+        });
         let bad_bin = |g: &Grid| {
             g.bins
                 .iter()
@@ -531,6 +566,8 @@ impl Tally {
             )
         } else if negative || l.detected.hits > photons || l.killed_photons > photons {
             "a sink holds negative weight, or more photons than were emitted".into()
+        } else if by_source_total != Some(l.detected) {
+            "the detections per source do not add up to the detections".into()
         } else if bad_bin(&self.flux)
             || bad_bin(&self.angular)
             || self.color.as_ref().is_some_and(|c| c.has_bad_bin(photons))

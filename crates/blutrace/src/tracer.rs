@@ -129,7 +129,7 @@ impl<'a> Tracer<'a> {
         out.ledger.photons += 1;
         out.ledger.emitted.add(1.0);
         let fate = self.follow(&mut p, &mut rng, out);
-        out.ledger.end(fate, p.weight);
+        out.ledger.end(fate, p.weight, e.source);
     }
 
     /// The photon loop: nearest event, the medium on the way, surface roulette, repeat;
@@ -345,6 +345,7 @@ impl<'a> Tracer<'a> {
         for i in lo..hi {
             self.trace_photon(seed, i, &mut out);
         }
+        out.ledger.sum_detected();
         out
     }
 }

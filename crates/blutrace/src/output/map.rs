@@ -105,7 +105,7 @@ struct Rendered {
 }
 
 /// A rectangle of pixels: `(columns, rows)`, ends excluded.
-type PixelRect = (Range<i32>, Range<i32>);
+pub(crate) type PixelRect = (Range<i32>, Range<i32>);
 
 /// Draw `grid` under `opts`.
 fn render_map(grid: &Grid, opts: &MapOptions) -> Result<Rendered> {
@@ -149,7 +149,7 @@ fn check(grid: &Grid) -> Result<()> {
 }
 
 /// The colour range `(lo, hi)` for `values` under `opts`.
-fn value_range(values: &[f64], opts: &MapOptions) -> Result<(f64, f64)> {
+pub(crate) fn value_range(values: &[f64], opts: &MapOptions) -> Result<(f64, f64)> {
     let lo = opts.min.unwrap_or(0.0);
     ensure!(lo.is_finite(), "map minimum {lo} is not finite");
     let hi = match opts.max {
@@ -173,7 +173,7 @@ fn is_drawable(v: f64, lo: f64) -> bool {
 }
 
 /// The colour of `v` in the range `(lo, hi)`.
-fn colour(v: f64, (lo, hi): (f64, f64)) -> RGBColor {
+pub(crate) fn colour(v: f64, (lo, hi): (f64, f64)) -> RGBColor {
     if !is_drawable(v, lo) {
         INVALID_GREY
     } else if hi > lo {
@@ -197,15 +197,15 @@ const LONG_SIDE: u32 = 640;
 /// The colour bar is at least this tall (a flat map is centred beside it).
 const BAR_MIN_H: u32 = 240;
 /// Width of the colour bar.
-const BAR_W: u32 = 26;
+pub(crate) const BAR_W: u32 = 26;
 /// Blank border around everything and between the map and the colour bar.
-const PAD: u32 = 16;
+pub(crate) const PAD: u32 = 16;
 /// Space between the map and the colour bar.
-const GAP: u32 = 28;
+pub(crate) const GAP: u32 = 28;
 /// Length of tick marks; `plotters` puts labels twice as far from the axis.
 const TICK: u32 = 5;
 /// Height of the title row.
-const TITLE_H: u32 = 44;
+pub(crate) const TITLE_H: u32 = 44;
 /// Tick labels wanted on the colour bar.
 const BAR_TICKS: usize = 6;
 
@@ -235,15 +235,15 @@ impl Layout {
         let plot = (side(ex), side(ey));
         let content_h = plot.1.max(BAR_MIN_H);
         // Text sizes need a drawing area; any will do (drawing on it cannot fail).
-        let mut m = Measures::default();
+        let (mut m, mut bar_area) = (Measures::default(), 0);
         let _ = render((1, 1), |a| {
-            m = Measures::of(a, grid, opts, plot, range);
+            m = Measures::of(a, grid, opts, plot);
+            bar_area = bar_label_area(a, &opts.unit, range);
             Ok(())
         });
         let desc = m.desc_h + 6;
         let y_area = 2 * TICK + m.y_label_w + 8 + if opts.y_label.is_empty() { 0 } else { desc };
         let x_area = 2 * TICK + m.label_h + 6 + if opts.x_label.is_empty() { 0 } else { desc };
-        let bar_area = 2 * TICK + m.bar_label_w + 8 + if opts.unit.is_empty() { 0 } else { desc };
         let w = PAD + y_area + plot.0 + GAP + BAR_W + bar_area + PAD;
         let w = w.max(m.title_w + 2 * PAD);
         let h = TITLE_H + content_h + x_area + PAD;
@@ -263,8 +263,6 @@ impl Layout {
 struct Measures {
     /// The widest tick label of the y axis.
     y_label_w: u32,
-    /// The widest tick label of the colour bar.
-    bar_label_w: u32,
     /// Height of a tick label.
     label_h: u32,
     /// Height of an axis description.
@@ -275,7 +273,7 @@ struct Measures {
 
 impl Measures {
     /// Measure the labels of `grid` drawn under `opts` with a plot area of `plot` pixels.
-    fn of(a: &Area, grid: &Grid, opts: &MapOptions, plot: (u32, u32), range: (f64, f64)) -> Self {
+    fn of(a: &Area, grid: &Grid, opts: &MapOptions, plot: (u32, u32)) -> Self {
         let (label, desc) = (text(LABEL_SIZE), text(DESC_SIZE));
         let widest = |ticks: Vec<f64>| {
             ticks
@@ -284,16 +282,33 @@ impl Measures {
                 .max()
                 .unwrap_or(0)
         };
-        let (lo, hi) = bar_range(range);
-        let height = |s: &TextStyle| a.estimate_text_size("0Ay", s).map_or(0, |(_, h)| h);
         Self {
             y_label_w: widest(axis(grid.y_mm).key_points(y_ticks(plot.1))),
-            bar_label_w: widest(RangedCoordf64::from(lo..hi).key_points(BAR_TICKS)),
-            label_h: height(&label),
-            desc_h: height(&desc),
+            label_h: text_height(a, &label),
+            desc_h: text_height(a, &desc),
             title_w: text_width(a, &opts.title, &text(TITLE_SIZE)),
         }
     }
+}
+
+/// Height of a line of text in `style` (pixels).
+pub(crate) fn text_height(a: &Area, style: &TextStyle) -> u32 {
+    a.estimate_text_size("0Ay", style).map_or(0, |(_, h)| h)
+}
+
+/// Width right of a colour bar of the range `range` for its tick labels and its `unit`
+/// (pixels), measured in the font.
+pub(crate) fn bar_label_area(a: &Area, unit: &str, range: (f64, f64)) -> u32 {
+    let (lo, hi) = bar_range(range);
+    let label = text(LABEL_SIZE);
+    let widest = RangedCoordf64::from(lo..hi)
+        .key_points(BAR_TICKS)
+        .iter()
+        .map(|v| text_width(a, &format_label(*v), &label))
+        .max()
+        .unwrap_or(0);
+    let desc = text_height(a, &text(DESC_SIZE)) + 6;
+    2 * TICK + widest + 8 + if unit.is_empty() { 0 } else { desc }
 }
 
 /// A linear axis over `[a, b]`.
@@ -330,7 +345,7 @@ fn draw(
     let map_w = l.y_area + l.plot.0 + GAP;
     let (map_area, bar_area) = body.split_horizontally(map_w);
     let map = draw_grid(&map_area, grid, range, opts, l)?;
-    let bar = draw_bar(&bar_area, opts, range, l)?;
+    let bar = draw_bar(&bar_area, &opts.unit, range, (l.x_area, l.bar_area))?;
     for (xs, ys) in [&map, &bar] {
         let r = [(xs.start - 1, ys.start - 1), (xs.end, ys.end)];
         root.draw(&Rectangle::new(r, FRAME.stroke_width(1)))
@@ -405,15 +420,22 @@ fn fill_pixels(
     Ok(())
 }
 
-/// The colour bar: `hi` at the top, tick labels and the unit right of it.
-fn draw_bar(area: &Area, opts: &MapOptions, range: (f64, f64), l: &Layout) -> Result<PixelRect> {
+/// The colour bar of `range` in `area` (from its top to `bottom` pixels above its
+/// bottom): `hi` at the top, tick labels and the `unit` right of it, in `label_area`
+/// pixels ([`bar_label_area`]).
+pub(crate) fn draw_bar(
+    area: &Area,
+    unit: &str,
+    range: (f64, f64),
+    (bottom, label_area): (u32, u32),
+) -> Result<PixelRect> {
     let (lo, hi) = bar_range(range);
     // The area is wider than the bar and its labels when the title is wider than the rest.
-    let right = area.dim_in_pixel().0.saturating_sub(BAR_W + l.bar_area);
+    let right = area.dim_in_pixel().0.saturating_sub(BAR_W + label_area);
     let mut chart = ChartBuilder::on(area)
-        .margin_bottom(l.x_area)
+        .margin_bottom(bottom)
         .margin_right(right)
-        .right_y_label_area_size(l.bar_area)
+        .right_y_label_area_size(label_area)
         .build_cartesian_2d(0.0..1.0, lo..hi)
         .map_err(drawing)?;
     let fmt = |v: &f64| format_label(*v);
@@ -427,7 +449,7 @@ fn draw_bar(area: &Area, opts: &MapOptions, range: (f64, f64), l: &Layout) -> Re
         .label_style(text(LABEL_SIZE))
         .axis_desc_style(text(DESC_SIZE))
         .axis_style(FRAME)
-        .y_desc(opts.unit.as_str())
+        .y_desc(unit)
         .draw()
         .map_err(drawing)?;
     let bar = chart.plotting_area().strip_coord_spec();

@@ -7,6 +7,7 @@
 //!   lossless ZIP compression) with text and number header attributes, plus a reader for
 //!   the files it writes.
 //! - [`map`]: false-colour maps (viridis, with a colour bar, title and mm axes) for people.
+//! - [`polar`]: polar false-colour plots of (theta, phi) grids (the conoscope view).
 //! - [`plot`]: line charts (convergence, optimizer histories).
 //! - [`figure`]: what maps and charts share: the embedded font, the colour map, drawing
 //!   with `plotters` into a buffer; `png`: encoding that buffer as a PNG file.
@@ -22,5 +23,6 @@ pub mod figure;
 pub mod map;
 pub mod plot;
 pub(crate) mod png;
+pub mod polar;
 #[cfg(test)]
 mod test_png;

@@ -1,4 +1,5 @@
-//! The run's images: the EXR files, laid out as image tools read them, and `flux.png`.
+//! The run's images: the EXR files, laid out as image tools read them, `flux.png` and
+//! `conoscope.png`.
 //!
 //! - `flux.exr`: channel `Y` = irradiance on the target plane (W/mm^2 per bin), so that any
 //!   viewer shows a grey image (values ~1e-5: scale it, or use `preview.Y`); layer `stderr`
@@ -25,6 +26,8 @@
 //! shortest round-trip form: exact, and read by every tool (OpenEXR's Python module's old
 //! `InputFile` API returns `None` for `double` attributes).
 //!
+//! `conoscope.png` is the angular distribution for people ([`write_conoscope_png`]).
+//!
 //! `flux.png` is the flux map for people: false colour over the detector in mm from its
 //! origin corner, titled with the scene, the photons and the extraction efficiency (all
 //! exact, so the picture of a run and of its merged shards are the same bytes).
@@ -35,6 +38,7 @@ use crate::output::atomic::SetDir;
 use crate::output::exr::{Attribute, Samples, write_channels};
 use crate::output::figure::thousands;
 use crate::output::map::{Grid, MapOptions, write_map};
+use crate::output::polar::{PolarGrid, write_polar};
 use anyhow::Result;
 use glam::DVec3;
 use std::path::Path;
@@ -65,6 +69,38 @@ pub(super) fn write_flux_png(run: &RunResult, path: &Path, flux: &Map) -> Result
         ..MapOptions::default()
     };
     write_map(path, &grid, &opts)
+}
+
+/// `conoscope.png`: the angular distribution as a conoscope shows it, luminance (cd/m^2,
+/// averaged over the target) when the sources give lumens or spectra, else radiant
+/// intensity (W/sr); theta is the radius (0 at the centre, 90 deg at the rim, rings every
+/// 20 deg), phi the polar angle from the detector's `u` (right) towards its `v` (up).
+pub(super) fn write_conoscope_png(run: &RunResult, path: &Path) -> Result<()> {
+    let (map, what, unit) = match metrics::luminance_map(&run.scene, &run.tally) {
+        Some(m) => (m, "luminance", "luminance (cd/m²)"),
+        None => (
+            run.angular_map(),
+            "radiant intensity",
+            "radiant intensity (W/sr)",
+        ),
+    };
+    let grid = PolarGrid {
+        n_theta: map.ny,
+        n_phi: map.nx,
+        values: &map.value,
+        theta_max_deg: 90.0,
+        ring_step_deg: 20.0,
+    };
+    let opts = MapOptions {
+        title: format!(
+            "{}: {what} by direction, {} photons",
+            run.scene.name,
+            thousands(run.tally.ledger.photons)
+        ),
+        unit: unit.into(),
+        ..MapOptions::default()
+    };
+    write_polar(path, &grid, &opts)
 }
 
 /// `flux.exr` of the map `flux`.

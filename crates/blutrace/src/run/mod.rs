@@ -421,6 +421,7 @@ pub const OUTPUT_NAMES: &[&str] = &[
     "flux.exr",
     "angular.exr",
     "flux.png",
+    "conoscope.png",
     "convergence.csv",
     "convergence.png",
     "summary.json",
@@ -462,6 +463,9 @@ impl RunResult {
         images::write_angular_exr(self, staged)?;
         color_images::write_color_images(self, staged)?;
         staged.write_with("flux.png", |png| images::write_flux_png(self, png, &flux))?;
+        staged.write_with("conoscope.png", |png| {
+            images::write_conoscope_png(self, png)
+        })?;
         staged.write_bytes(
             "convergence.csv",
             summary::convergence_csv(&self.history).as_bytes(),

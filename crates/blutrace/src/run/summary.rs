@@ -126,6 +126,8 @@ pub struct LedgerSummary {
     pub absorbed_in_medium_w: BTreeMap<String, f64>,
     /// Power absorbed per source by its lamp body (0 for transparent bodies).
     pub absorbed_by_source_w: BTreeMap<String, f64>,
+    /// Power on the target per source, in source order (it adds up to `detected_w`).
+    pub detected_by_source_w: Vec<SourceDetected>,
     /// Power that left the scene.
     pub escaped_w: f64,
     /// Power stopped by the bounce cap.
@@ -145,6 +147,17 @@ pub struct LedgerSummary {
     pub groove_hits_by_tag: BTreeMap<String, u64>,
     /// (accounted - emitted) / emitted, computed on the exact sums.
     pub balance_rel_error: f64,
+}
+
+/// The power one source puts on the target.
+#[derive(Clone, Debug, Serialize)]
+pub struct SourceDetected {
+    /// The source's name.
+    pub source: String,
+    /// Power on the target (W).
+    pub w: f64,
+    /// Its standard error (W), from the per-photon sums of squares.
+    pub stderr_w: f64,
 }
 
 /// Detector facts for the summary.
@@ -219,6 +232,15 @@ impl RunResult {
                 absorbed_w: named(&self.scene.tags, &l.absorbed_by_surface),
                 absorbed_in_medium_w: named(&media, &l.absorbed_in_medium),
                 absorbed_by_source_w: named(&sources, &l.absorbed_by_source),
+                detected_by_source_w: sources
+                    .iter()
+                    .zip(&l.detected_by_source)
+                    .map(|(name, b)| SourceDetected {
+                        source: name.clone(),
+                        w: b.sum.value() * w,
+                        stderr_w: b.mean_and_stderr(l.photons).1 * self.scene.sources.total_power(),
+                    })
+                    .collect(),
                 escaped_w: l.escaped.value() * w,
                 killed_w: l.killed.value() * w,
                 killed_photons: l.killed_photons,

@@ -205,49 +205,37 @@ pub fn bsdf_case(target: &str, data: &[u8]) {
 /// Photons arriving at the slab's back face (tag `lgp_back`) at 0-89 degrees, from air
 /// below and from the PMMA above, scattered by its model.
 fn scatter_back_face(scene: &Scene) {
+    let tag = scene.tags.iter().position(|t| t == "lgp_back");
+    let pmma = scene.media.iter().position(|m| m.name == "pmma");
+    let (Some(tag), Some(pmma)) = (tag, pmma) else {
+        panic!("the fixture scene has lgp_back and pmma");
+    };
+    for deg in [0.0f64, 30.0, 60.0, 89.0] {
+        let (s, c) = deg.to_radians().sin_cos();
+        scatter_from(scene, tag, glam::DVec3::new(s, 0.0, c), 0);
+        scatter_from(scene, tag, glam::DVec3::new(s, 0.0, -c), pmma as u16);
+    }
+}
+
+/// [`DRAWS`] photons along `dir` in medium `medium` meeting the back face (normal -z) of
+/// tag `tag`, analog and weighted: every one that leaves goes along a unit direction with
+/// a weight within [0, 1].
+fn scatter_from(scene: &Scene, tag: usize, dir: glam::DVec3, medium: u16) {
     use blutrace::estimator::Estimator;
-    use blutrace::geometry::SurfaceHit;
     use blutrace::optics::surface::Outcome;
-    use glam::DVec3;
-    let tag = scene
-        .tags
-        .iter()
-        .position(|t| t == "lgp_back")
-        .expect("tag");
-    let pmma = scene
-        .media
-        .iter()
-        .position(|m| m.name == "pmma")
-        .expect("pmma");
-    let hit = SurfaceHit {
+    let hit = blutrace::geometry::SurfaceHit {
         t: 1.0,
         prim: 0,
-        point: DVec3::new(10.0, 10.0, 0.0),
-        normal: -DVec3::Z,
+        point: glam::DVec3::new(10.0, 10.0, 0.0),
+        normal: -glam::DVec3::Z,
     };
-    for (deg, below) in [0.0f64, 30.0, 60.0, 89.0]
-        .into_iter()
-        .flat_map(|a| [(a, true), (a, false)])
-    {
-        let (s, c) = deg.to_radians().sin_cos();
-        let (dir, medium) = if below {
-            (DVec3::new(s, 0.0, c), 0)
-        } else {
-            (DVec3::new(s, 0.0, -c), pmma as u16)
-        };
-        for est in [Estimator::Analog, Estimator::Weighted] {
-            for i in 0..DRAWS {
-                let mut rng = blutrace::rng::PhotonRng::new(2, i);
-                let out =
-                    scene.surfaces[tag].interact(&scene.media, &hit, dir, medium, est, &mut rng);
-                if let Outcome::Scattered { dir: d, weight, .. } = out {
-                    let w_ok = weight.is_finite() && (0.0..=1.0 + 1e-9).contains(&weight);
-                    assert!(
-                        unit(d) && w_ok,
-                        "AOI {deg} ({}): {d}, weight {weight}",
-                        if below { "air" } else { "pmma" }
-                    );
-                }
+    for est in [Estimator::Analog, Estimator::Weighted] {
+        for i in 0..DRAWS {
+            let mut rng = blutrace::rng::PhotonRng::new(2, i);
+            let out = scene.surfaces[tag].interact(&scene.media, &hit, dir, medium, est, &mut rng);
+            if let Outcome::Scattered { dir: d, weight, .. } = out {
+                let w_ok = weight.is_finite() && (0.0..=1.0 + 1e-9).contains(&weight);
+                assert!(unit(d) && w_ok, "from {dir}: to {d}, weight {weight}");
             }
         }
     }

@@ -326,6 +326,19 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
             lum.efficacy_lm_per_w
         );
     }
+    if let Some(m) = &s.luminance_map {
+        let num = |x: f64, digits: usize| err(x, digits, false);
+        say!(
+            "luminance  map within {}° of the normal: mean {} ± {} cd/m², 13-point min/max {} ± {}, cv {} (noise floor {})",
+            m.cone_deg,
+            num(m.mean_cd_m2.value, 1),
+            err(m.mean_cd_m2.stderr, 1, false),
+            num(m.thirteen_point_min_over_max.value, 3),
+            err(m.thirteen_point_min_over_max.stderr, 3, false),
+            num(m.cv.value, 3),
+            num(m.cv_noise_floor, 3)
+        );
+    }
     for f in files {
         say!("wrote      {}", f.display());
     }

@@ -48,11 +48,37 @@
 //! - photons are counted per chunk in a small tally (fate counters in an array), and
 //!   the run of guide steps is a loop of its own: about 1.06x together.
 //!
+//! Then, for the 2x (1.58-1.74x above; A/B rounds of 2-4 million photons, each
+//! change against the build before it):
+//! - a photon moving towards the plain face across the thickness from the dotted one,
+//!   totally reflected there (no draw: the cosine alone decides), takes both steps to
+//!   the dotted face as one (`there_and_back`): 1.07x;
+//! - and takes them as a run: with total reflection at both faces (the same cosine), its
+//!   landings on the dotted face lie at path lengths `back + j period` until one lands
+//!   in a dot, so the dot lookups are independent of each other and run back to back
+//!   instead of one per link of the position's chain (`run`), the run's
+//!   length bounded beforehand by the sides, the optical depth left and the bounce cap,
+//!   without a division or a libm `floor`/`ceil` call (x86-64's baseline has no rounding
+//!   instruction: 4.6 % of the profile before): 1.17x with the step of two;
+//! - a photon in air stands on the surface it last met, moving away from it: that
+//!   surface is not tested (the guide is convex, the sheet and the strip flat, so the
+//!   test could only say "no"): 1.05-1.08x;
+//! - an air step takes one reciprocal of the direction for all its planes and finds the
+//!   guide's entry by slabs without branches but the answer's: 1.03x.
+//!
+//! Together 1.90-2.00x the old kernel single-threaded (interleaved rounds in one run);
+//! see the README's bench section for the last measurement.
+//!
 //! Measured and not kept, because they bought nothing measurable: Fresnel's roulette
-//! without its two divisions; one reciprocal for all the planes of an air step; walking
-//! the guide as three independent billiards (the hits along each axis are periodic
-//! between changes of direction, positions computed only at the dotted face). Not
-//! costs: the per-photon generator start (a generator per chunk instead: within 2 %),
+//! without its two divisions (1.00x, twice); one reciprocal for all the planes of an air
+//! step (before the entry test lost its branches); walking the guide as three
+//! independent billiards (the hits along each axis are periodic between changes of
+//! direction, positions computed only at the dotted face); a Lambertian direction
+//! without rejection (radius `sqrt(u)`, the angle in an octant by Taylor series placed by
+//! three random bits, no branch: 1.00x); emission points and Lambertian directions built
+//! in registers instead of lane by lane at runtime indices (1.00x); starting runs at the
+//! dotted face as well as at the plain one (0.94x).
+//! Not costs: the per-photon generator start (a generator per chunk instead: within 2 %),
 //! `ln` per photon (0.3 % of the profile), the chunk loop and its counting (2 %).
 //!
 //! Why `f32` is safe here: positions in the recentred scene (within 70 mm of the origin
@@ -73,6 +99,9 @@ use anyhow::Result;
 use blutrace::scene::Scene;
 use glam::Vec3;
 use rayon::prelude::*;
+use rng::{Rng, splitmix64};
+
+mod rng;
 
 /// Photons per work unit, as blutrace's.
 const CHUNK: u64 = 4096;
@@ -194,6 +223,13 @@ impl Interface {
         }
     }
 
+    /// Total internal reflection at incidence cosine `cos_i` (where [`Interface::refract`]
+    /// reflects without a draw).
+    #[inline(always)]
+    fn reflects(&self, cos_i: f32) -> bool {
+        self.one_minus_eta2 + self.eta2 * cos_i * cos_i <= 0.0
+    }
+
     /// Fresnel roulette at incidence cosine `cos_i`: `None` when reflected (always under
     /// total internal reflection, without a draw), else `cos t` of the refracted
     /// direction.
@@ -268,6 +304,17 @@ pub struct Reference {
     cells: Cells,
     /// Flux bins per mm along the target's u and v, signed as its axes.
     bins_per_mm: [f32; 2],
+    /// The guide's thickness along z.
+    thick: f32,
+    /// The sign along z of a photon moving towards the plain face across from the dotted
+    /// one (0 when the dots are not on a z face: no shortcut).
+    plain_side: f32,
+    /// The dotted face's z (when it is a z face).
+    dotted_at: f32,
+    /// `1 / (2 thick)`, and the absorption's reciprocal (mm).
+    per_two_thick: f32,
+    /// See `per_two_thick`.
+    per_absorption: f32,
 }
 
 impl Reference {
@@ -283,6 +330,15 @@ impl Reference {
                 g.u.1 * g.bins[0] as f32 / g.size[0],
                 g.v.1 * g.bins[1] as f32 / g.size[1],
             ],
+            thick: s.hi[2] - s.lo[2],
+            per_two_thick: 0.5 / (s.hi[2] - s.lo[2]),
+            per_absorption: 1.0 / s.absorption,
+            dotted_at: if s.dots.face == 5 { s.hi[2] } else { s.lo[2] },
+            plain_side: match s.dots.face {
+                4 => 1.0,
+                5 => -1.0,
+                _ => 0.0,
+            },
             s,
         })
     }
@@ -362,9 +418,12 @@ impl Reference {
         // Optical depth left before the guide's bulk absorbs the photon.
         let mut depth = -(1.0 - rng.uniform()).ln();
         let mut n = 0;
+        // The surface the photon stands on, moving away from it: it cannot meet it next.
+        let mut on = Struck::Body;
         while n < s.max_bounces {
-            let (t, struck) = self.nearest_in_air(p, d);
-            if let Some(bin) = self.detected(p, d, t) {
+            let inv = d.recip();
+            let (t, struck) = self.nearest_in_air(p, d, inv, on);
+            if let Some(bin) = self.detected(p, d, inv, t) {
                 let g = &s.target;
                 let near_normal = d[g.rect.axis] * g.normal_sign > COS_30;
                 return (Fate::Detected(bin, near_normal), n);
@@ -374,6 +433,7 @@ impl Reference {
             };
             let from = p;
             p += d * t;
+            on = struck;
             match struck {
                 Struck::Guide(face) => {
                     let k = face / 2;
@@ -391,7 +451,7 @@ impl Reference {
                         if let Some(fate) = fate {
                             return (fate, m);
                         }
-                        (p, d, n) = (q, e, m);
+                        (p, d, n, on) = (q, e, m, Struck::Guide(0));
                         continue;
                     } else {
                         d[k] = -d[k];
@@ -447,11 +507,24 @@ impl Reference {
             // selects: they are predicted (most steps cross the thickness), so the
             // position's dependency chain does not wait for the comparisons.
             let end = if t[2] < t[0] && t[2] < t[1] {
-                self.face::<2>(&mut g, t[2], depth, rng)
+                // Towards the plain face across from the dotted one, totally reflected
+                // there, and back at the dotted face before any side: a run of landings
+                // on the dotted face ([`Reference::run`]).
+                let back = t[2] + self.thick * g.inv[2].abs();
+                if g.d[2] * self.plain_side > 0.0
+                    && self.leave.reflects(g.d[2].abs())
+                    && back < t[0]
+                    && back < t[1]
+                    && g.n + 1 < self.s.max_bounces
+                {
+                    self.run(&mut g, t[2], back, t[0].min(t[1]), depth, rng)
+                } else {
+                    self.face::<2>(&mut g, t[2], t[2], depth, rng)
+                }
             } else if t[0] <= t[1] {
-                self.face::<0>(&mut g, t[0], depth, rng)
+                self.face::<0>(&mut g, t[0], t[0], depth, rng)
             } else {
-                self.face::<1>(&mut g, t[1], depth, rng)
+                self.face::<1>(&mut g, t[1], t[1], depth, rng)
             };
             if let Some(end) = end {
                 return (Vec3::from_array(g.p), Vec3::from_array(g.d), end, g.n);
@@ -463,17 +536,19 @@ impl Reference {
 
     /// A photon inside the guide moves `step` to its face along axis `K` and meets it:
     /// `None` when it stays inside, `Some(None)` when it refracts out, `Some(fate)` when
-    /// it ends.
+    /// it ends. `run` is the path length absorption is drawn along (`step`, or the last
+    /// leg of a step of two).
     #[inline(always)]
     fn face<const K: usize>(
         &self,
         g: &mut Guided,
         step: f32,
+        run: f32,
         depth: &mut f32,
         rng: &mut Rng,
     ) -> Option<Option<Fate>> {
         let s = &self.s;
-        let tau = s.absorption * step;
+        let tau = s.absorption * run;
         if tau > *depth {
             return Some(Some(Fate::Medium));
         }
@@ -505,45 +580,147 @@ impl Reference {
         None
     }
 
-    /// Where a photon in air enters the guide (slabs): distance and face.
-    #[inline]
-    fn entry(&self, p: Vec3, d: Vec3) -> Option<(f32, usize)> {
-        let (lo, hi) = (self.s.lo, self.s.hi);
-        let (mut t0, mut t1, mut face) = (f32::NEG_INFINITY, f32::INFINITY, 0);
-        for k in 0..3 {
-            let (near, far, f) = if d[k] > 0.0 {
-                ((lo[k] - p[k]) / d[k], (hi[k] - p[k]) / d[k], 2 * k)
-            } else if d[k] < 0.0 {
-                ((hi[k] - p[k]) / d[k], (lo[k] - p[k]) / d[k], 2 * k + 1)
-            } else if p[k] < lo[k] || p[k] > hi[k] {
-                return None;
-            } else {
-                continue;
-            };
-            if near > t0 {
-                (t0, face) = (near, f);
-            }
-            t1 = t1.min(far);
+    /// A photon inside the guide moving towards the plain face across the thickness from
+    /// the dotted one, totally reflected there (no draw), meets the dotted face at `back`:
+    /// the two interactions in one step, the same as two calls of [`Reference::face`]
+    /// (1.07x).
+    #[inline(always)]
+    fn there_and_back(
+        &self,
+        g: &mut Guided,
+        there: f32,
+        back: f32,
+        depth: &mut f32,
+        rng: &mut Rng,
+    ) -> Option<Option<Fate>> {
+        let tau = self.s.absorption * there;
+        if tau > *depth {
+            return Some(Some(Fate::Medium));
         }
-        (t0 > 0.0 && t0 <= t1).then_some((t0, face))
+        *depth -= tau;
+        g.n += 1;
+        g.d[2] = -g.d[2];
+        g.inv[2] = -g.inv[2];
+        self.face::<2>(g, back, back - there, depth, rng)
+    }
+
+    /// A photon inside the guide moving towards the plain face (`there` away), totally
+    /// reflected there: its run of landings on the dotted face, at path lengths
+    /// `back + j period`, all totally reflected (the same cosine at both faces) until one
+    /// lands in a dot, or the next would be beyond a side (`side` away), past the optical
+    /// depth left or past the bounce cap. The landings have no draws and depend on
+    /// nothing but `j`, so the dot lookups run back to back, not one per step of a chain
+    /// (1.17x with the step of two, [`Reference::there_and_back`]). The photon then stands on its last landing, as
+    /// after two calls of [`Reference::face`] per landing: in a dot it meets the ink,
+    /// otherwise it moves on towards the plain face.
+    #[inline(always)]
+    fn run(
+        &self,
+        g: &mut Guided,
+        there: f32,
+        back: f32,
+        side: f32,
+        depth: &mut f32,
+        rng: &mut Rng,
+    ) -> Option<Option<Fate>> {
+        let s = &self.s;
+        let period = 2.0 * self.thick * g.inv[2].abs();
+        let per_period = g.d[2].abs() * self.per_two_thick;
+        let landing = |j: u32| back + j as f32 * period;
+        // Landings within `x` periods of the first: `x + 1` rounded down (the conversion
+        // saturates), perhaps one too many, which the loop below takes back (as it does
+        // rounding's).
+        let within = |x: f32| (x as u32).saturating_add(1);
+        // Landing j is interaction `n + 2 j + 2`, at most the cap.
+        let mut count = ((s.max_bounces - g.n) / 2).min(within((side - back) * per_period));
+        if s.absorption > 0.0 {
+            count = count.min(within((*depth * self.per_absorption - back) * per_period));
+        }
+        while count > 0
+            && (landing(count - 1) >= side || s.absorption * landing(count - 1) > *depth)
+        {
+            count -= 1;
+        }
+        if count == 0 {
+            return self.there_and_back(g, there, back, depth, rng);
+        }
+        let c = &self.cells;
+        let r = Vec3::new(g.p[0], g.p[1], self.dotted_at) + Vec3::new(g.d[0], g.d[1], 0.0) * back
+            - c.origin;
+        let hop = Vec3::new(g.d[0], g.d[1], 0.0) * period;
+        let (w0, z0) = (r.dot(c.axis), r.dot(c.across));
+        let (dw, dz) = (hop.dot(c.axis), hop.dot(c.across));
+        let (mut j, mut jf) = (0, 0.0);
+        let inked = loop {
+            if j == count {
+                break false;
+            }
+            if self.in_dot(w0 + jf * dw, z0 + jf * dz) {
+                break true;
+            }
+            j += 1;
+            jf += 1.0;
+        };
+        let last = if inked { j } else { j - 1 };
+        let run = landing(last);
+        *depth -= s.absorption * run;
+        g.n += 2 * (last + 1);
+        g.p = [g.p[0] + g.d[0] * run, g.p[1] + g.d[1] * run, self.dotted_at];
+        if inked {
+            if rng.uniform() >= s.dots.ink_albedo {
+                return Some(Some(Fate::Ink));
+            }
+            g.d = lambertian(2, self.plain_side, rng);
+            g.inv = g.d.map(|x| 1.0 / x);
+        }
+        None
+    }
+
+    /// Where a photon in air enters the guide (slabs, `inv` the direction's reciprocal):
+    /// distance and face. Without branches but the answer's: an axis the photon does not
+    /// move along gives infinite slab distances, which never bound it when it lies
+    /// between the faces and empty it otherwise.
+    #[inline]
+    fn entry(&self, p: Vec3, d: Vec3, inv: Vec3) -> Option<(f32, usize)> {
+        let (a, b) = ((self.s.lo - p) * inv, (self.s.hi - p) * inv);
+        let (near, far) = (a.min(b), a.max(b));
+        let (t0, t1) = (near.max_element(), far.min_element());
+        if !(t0 > 0.0 && t0 <= t1) {
+            return None;
+        }
+        // The lowest axis on ties.
+        let k = if near.x == t0 {
+            0
+        } else if near.y == t0 {
+            1
+        } else {
+            2
+        };
+        Some((t0, 2 * k + usize::from(d[k] < 0.0)))
     }
 
     /// The surface a photon in air meets first (guide, sheet or the strip's body), with
-    /// its distance (infinite when none).
+    /// its distance (infinite when none). The photon stands on `on`, moving away from it,
+    /// so it cannot meet it (the guide is convex, the others are flat): it is not tested.
     #[inline]
-    fn nearest_in_air(&self, p: Vec3, d: Vec3) -> (f32, Option<Struck>) {
+    fn nearest_in_air(&self, p: Vec3, d: Vec3, inv: Vec3, on: Struck) -> (f32, Option<Struck>) {
         let s = &self.s;
-        let (mut t, mut struck) = match self.entry(p, d) {
+        let (mut t, mut struck) = match (!matches!(on, Struck::Guide(_)))
+            .then(|| self.entry(p, d, inv))
+            .flatten()
+        {
             Some((t, face)) => (t, Some(Struck::Guide(face))),
             None => (f32::INFINITY, None),
         };
-        if let Some(ts) = s.sheet.hit(p, d)
+        if !matches!(on, Struck::Sheet)
+            && let Some(ts) = hit(&s.sheet, p, d, inv)
             && ts < t
         {
             (t, struck) = (ts, Some(Struck::Sheet));
         }
         if s.strip.body != Body::Transparent
-            && let Some(tb) = s.strip.rect.hit(p, d)
+            && !matches!(on, Struck::Body)
+            && let Some(tb) = hit(&s.strip.rect, p, d, inv)
             && tb < t
         {
             (t, struck) = (tb, Some(Struck::Body));
@@ -554,12 +731,12 @@ impl Reference {
     /// The flux bin of a photon in air crossing the target along its normal nearer than
     /// `t_surface`.
     #[inline]
-    fn detected(&self, p: Vec3, d: Vec3, t_surface: f32) -> Option<usize> {
+    fn detected(&self, p: Vec3, d: Vec3, inv: Vec3, t_surface: f32) -> Option<usize> {
         let g = &self.s.target;
         if d[g.rect.axis] * g.normal_sign <= 0.0 {
             return None;
         }
-        let t = g.rect.hit(p, d).filter(|&t| t < t_surface)?;
+        let t = hit(&g.rect, p, d, inv).filter(|&t| t < t_surface)?;
         let q = p + d * t - g.origin;
         let bin = |k: usize, per_mm: f32, n: usize| ((q[k] * per_mm) as usize).min(n - 1);
         let [nu, nv] = g.bins;
@@ -579,7 +756,14 @@ impl Reference {
     fn ink(&self, p: [f32; 3]) -> bool {
         let c = &self.cells;
         let r = Vec3::from_array(p) - c.origin;
-        let (w, z) = (r.dot(c.axis), r.dot(c.across));
+        self.in_dot(r.dot(c.axis), r.dot(c.across))
+    }
+
+    /// True when the point `(w, z)` of the pattern in cell units ([`Cells`]) lies inside
+    /// a dot.
+    #[inline(always)]
+    fn in_dot(&self, w: f32, z: f32) -> bool {
+        let c = &self.cells;
         let (rw, rz) = ((w + ROUND) - ROUND, (z + ROUND) - ROUND);
         let column = (w + ROUND).to_bits() as i32 - ROUND.to_bits() as i32;
         let col = (column - c.col0).clamp(0, c.r2.len() as i32 - 1) as usize;
@@ -596,6 +780,18 @@ const ROUND: f32 = 12_582_912.0;
 #[inline]
 fn side(face: usize) -> f32 {
     if face % 2 == 1 { 1.0 } else { -1.0 }
+}
+
+/// [`AaRect::hit`] with the direction's reciprocal `inv`: no division.
+#[inline]
+fn hit(r: &AaRect, p: Vec3, d: Vec3, inv: Vec3) -> Option<f32> {
+    let (k1, k2) = AaRect::others(r.axis);
+    let t = (r.at - p[r.axis]) * inv[r.axis];
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    let (a, b) = (p[k1] + d[k1] * t, p[k2] + d[k2] * t);
+    (a >= r.lo[0] && a <= r.hi[0] && b >= r.lo[1] && b <= r.hi[1]).then_some(t)
 }
 
 /// A uniform point of `r`.
@@ -623,130 +819,5 @@ fn lambertian(k: usize, sign: f32, rng: &mut Rng) -> [f32; 3] {
     }
 }
 
-/// xoshiro128++ with a per-photon start.
-struct Rng([u32; 4]);
-
-impl Rng {
-    /// Photon `index`'s generator under `key`, SplitMix64 of the seed.
-    #[inline]
-    fn new(key: u64, index: u64) -> Self {
-        let a = splitmix64(key ^ index);
-        let b = splitmix64(a ^ 0xD1B5_4A32_D192_ED03);
-        let s = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32];
-        Rng(if s == [0; 4] { [1, 0, 0, 0] } else { s })
-    }
-
-    #[inline]
-    fn next_u32(&mut self) -> u32 {
-        let s = &mut self.0;
-        let out = s[0].wrapping_add(s[3]).rotate_left(7).wrapping_add(s[0]);
-        let t = s[1] << 9;
-        s[2] ^= s[0];
-        s[3] ^= s[1];
-        s[1] ^= s[2];
-        s[0] ^= s[3];
-        s[2] ^= t;
-        s[3] = s[3].rotate_left(11);
-        out
-    }
-
-    /// A uniform number in `[0, 1)` with 24 random bits.
-    #[inline]
-    fn uniform(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
-    }
-}
-
-/// SplitMix64's finalizer (Steele, Lea and Flood 2014): a bijective 64-bit mixer.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use std::path::Path;
-
-    fn bench_box() -> Scene {
-        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes/bench-box");
-        Scene::load(&dir.join("scene.toml")).unwrap()
-    }
-
-    #[test]
-    fn every_photon_has_one_fate_for_any_thread_count() {
-        let r = Reference::new(&bench_box()).unwrap();
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let three = rayon::ThreadPoolBuilder::new()
-            .num_threads(3)
-            .build()
-            .unwrap();
-        let a = one.install(|| r.trace(5, 20_000));
-        let b = three.install(|| r.trace(5, 20_000));
-        assert_eq!(a, b);
-        assert_eq!(a.fates(), 20_000);
-        assert_eq!(a.flux.iter().sum::<u64>(), a.detected);
-        assert!(a.detected > 0 && a.absorbed_by_ink > 0 && a.escaped > 0);
-    }
-
-    #[test]
-    fn reads_the_scene() {
-        let r = Reference::new(&bench_box()).unwrap();
-        let s = r.scene();
-        let size = s.hi - s.lo - Vec3::new(120.0, 80.0, 3.0);
-        assert!(size.abs().max_element() < 1e-4, "{size}");
-        assert_eq!((s.n_guide, s.n_air, s.absorption), (1.49, 1.0, 0.0003));
-        assert_eq!(
-            (s.dots.face, s.dots.pitch, s.dots.ink_albedo),
-            (4, 0.5, 0.9)
-        );
-        assert_eq!((s.sheet.axis, s.sheet_albedo), (2, 0.96));
-        assert_eq!(s.strip.body, Body::Lambert(0.8));
-        assert_eq!((s.target.bins, s.target.normal_sign), ([120, 80], 1.0));
-        // Dot radius at the lit edge: d = 0.05 + 0.2 u + 0.4 u^2 at u = 0.25 / 120.
-        let u = 0.25 / 120.0;
-        let d = 0.05 + 0.2 * u + 0.4 * u * u;
-        let r2 = s.dots.r2[(-s.dots.col0) as usize];
-        assert!((f64::from(r2) - d * 0.25 / std::f64::consts::PI).abs() < 1e-8);
-    }
-
-    #[test]
-    fn refuses_other_scenes_saying_why() {
-        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
-        for (scene, why) in [
-            ("notebook14", "square lattice"),
-            ("edge-holder", "more than one part"),
-            ("direct-lit", "scatters"),
-            ("test/slab", "no dotted face"),
-        ] {
-            let s = Scene::load(&dir.join(scene).join("scene.toml")).unwrap();
-            let e = Reference::new(&s).err().expect("refused").to_string();
-            assert!(
-                e.contains("box-guide scenes") && e.contains(why),
-                "{scene}: {e}"
-            );
-        }
-    }
-
-    #[test]
-    fn fresnel_matches_the_closed_form_at_normal_incidence() {
-        // R0 = ((n - 1)/(n + 1))^2: the share of reflections over many draws.
-        let mut rng = Rng::new(1, 2);
-        let n = 200_000;
-        let reflected = (0..n)
-            .filter(|_| Interface::new(1.0, 1.49).refract(1.0, &mut rng).is_none())
-            .count();
-        let r0 = (0.49f64 / 2.49).powi(2);
-        let se = (r0 * (1.0 - r0) / n as f64).sqrt();
-        assert!((reflected as f64 / n as f64 - r0).abs() < 4.0 * se);
-        assert!(
-            Interface::new(1.49, 1.0).refract(0.5, &mut rng).is_none(),
-            "beyond critical"
-        );
-    }
-}
+mod tests;

@@ -8,7 +8,16 @@
 //! size_mm = [300.0, 200.0]
 //! bins = [100, 100]
 //! angular_bins = [18, 36]    # theta over [0, 90] deg from the normal, phi over [0, 360)
+//! luminance_cone_deg = 2.0   # half-angle about the normal of the luminance map's cone
 //! ```
+//!
+//! The luminance map (cd/m², with lumens or spectra) counts the light leaving each bin
+//! within `luminance_cone_deg` of the normal, as a luminance meter aimed at the panel
+//! does. Default 2 degrees: a meter's lens accepts the rays from each point it sees within
+//! atan(D / 2L) of its axis, 2.0 degrees for a 35 mm aperture at 500 mm, and spot meters'
+//! measuring angles are of that size (Topcon BM-7: 0.1, 0.2, 1 and 2 degrees, BM-7A/BM-7AC
+//! manual; Gamma Scientific GS-1160B: ±1 degree acceptance). A narrow cone sees few
+//! photons: the map's errors say how many more it needs.
 //!
 //! A photon crossing the rectangle along the normal (from the back, towards the viewer)
 //! is detected and stops there; one crossing the other way passes through.
@@ -38,6 +47,13 @@ pub struct DetectorSpec {
     /// Angular bins (theta, phi).
     #[serde(default = "default_angular_bins")]
     pub angular_bins: [usize; 2],
+    /// Half-angle (degrees) of the luminance map's cone about the normal.
+    #[serde(default = "default_luminance_cone_deg")]
+    pub luminance_cone_deg: f64,
+}
+
+fn default_luminance_cone_deg() -> f64 {
+    2.0
 }
 
 fn default_bins() -> [usize; 2] {
@@ -70,7 +86,16 @@ impl DetectorSpec {
                 ));
             }
         }
+        let cone = d.luminance_cone_deg;
+        if !(cone > 0.0 && cone <= 90.0) {
+            return Err(ctx.err(
+                "detector.luminance_cone_deg",
+                format!("must be within (0, 90] degrees, got {cone}"),
+            ));
+        }
         Ok(TargetPlane {
+            luminance_cone_deg: cone,
+            cone_cos: cone.to_radians().cos(),
             origin: ctx.point("detector.origin", d.origin)?,
             u,
             v,
@@ -99,12 +124,27 @@ pub struct TargetPlane {
     pub bins: [usize; 2],
     /// Angular bins: theta (0..90 deg) and phi (0..360 deg).
     pub angular_bins: [usize; 2],
+    /// Half-angle (degrees) of the luminance map's cone about the normal.
+    pub luminance_cone_deg: f64,
+    /// Its cosine.
+    pub cone_cos: f64,
 }
 
 impl TargetPlane {
     /// Unit normal: the direction photons are detected travelling along.
     pub fn normal(&self) -> DVec3 {
         self.u.cross(self.v)
+    }
+
+    /// Whether a detected direction lies within the luminance cone.
+    #[inline]
+    pub fn in_cone(&self, dir: DVec3) -> bool {
+        dir.dot(self.normal()) >= self.cone_cos
+    }
+
+    /// Projected solid angle of the luminance cone, `pi sin^2(half-angle)` (sr).
+    pub fn cone_projected_solid_angle(&self) -> f64 {
+        std::f64::consts::PI * self.luminance_cone_deg.to_radians().sin().powi(2)
     }
 
     /// Size of one flux bin along u and v (mm).
@@ -237,6 +277,8 @@ mod tests {
             size: [10.0, 5.0],
             bins: [10, 5],
             angular_bins: [9, 12],
+            luminance_cone_deg: 2.0,
+            cone_cos: 2.0f64.to_radians().cos(),
         }
     }
 

@@ -478,6 +478,10 @@ pub struct Tally {
     /// X, Y, Z of the detected light, when the sources have spectra ([`color`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub color: Option<ColorTally>,
+    /// Per flux bin, the light detected within the luminance cone (spectral: ȳ-weighted,
+    /// as the Y tally; else radiant weight), when the sources give lumens or spectra.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cone: Option<Grid>,
 }
 
 impl Tally {
@@ -491,6 +495,8 @@ impl Tally {
                 .sources
                 .spectral()
                 .then(|| ColorTally::new(&flux, &angular)),
+            cone: (scene.sources.spectral() || scene.sources.luminous_efficacy().is_some())
+                .then(|| Grid::new(flux.nx, flux.ny)),
             flux,
             angular,
             ledger: Ledger::new(
@@ -526,6 +532,7 @@ impl Tally {
             ]
             .into_iter()
             .chain(t.color.iter().flat_map(ColorTally::shape))
+            .chain(t.cone.iter().map(|g| (g.nx, g.ny, g.bins.len())))
             .collect::<Vec<_>>()
         };
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
@@ -571,6 +578,7 @@ impl Tally {
         } else if bad_bin(&self.flux)
             || bad_bin(&self.angular)
             || self.color.as_ref().is_some_and(|c| c.has_bad_bin(photons))
+            || self.cone.as_ref().is_some_and(bad_bin)
         {
             "a bin holds negative weight, or more photons than were emitted".into()
         } else {
@@ -591,6 +599,9 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
             a.checked_merge(b)?;
         }
+        if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
+            a.checked_merge(b)?;
+        }
         self.ledger.checked_merge(&o.ledger)
     }
 
@@ -599,6 +610,9 @@ impl Tally {
         self.flux.merge_signed(&o.flux, sign);
         self.angular.merge_signed(&o.angular, sign);
         if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
+            a.merge_signed(b, sign);
+        }
+        if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
             a.merge_signed(b, sign);
         }
         self.ledger.merge_signed(&o.ledger, sign);
@@ -629,6 +643,13 @@ impl Tally {
         if let Some(color) = &mut self.color {
             color.absorb(&c.detections, xyz);
         }
+        if let Some(cone) = &mut self.cone {
+            for (i, d) in c.detections.iter().enumerate().filter(|(_, d)| d.in_cone) {
+                // The luminous weight: Y in a spectral run, else the radiant weight.
+                let one = xyz.get(i).map_or(&scored[i], |x| &x[1]);
+                cone.bins[d.flux_bin as usize].merge(one);
+            }
+        }
         self.ledger.merge(&c.ledger);
     }
 }
@@ -644,6 +665,8 @@ pub struct Detection {
     pub weight: f64,
     /// The photon's light (its wavelength, for the colour tallies).
     pub light: Light,
+    /// Whether it left within the detector's luminance cone.
+    pub in_cone: bool,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between

@@ -470,6 +470,7 @@ fn detection(
         angular_bin: d.angular_index(dir) as u32,
         weight,
         light,
+        in_cone: d.in_cone(dir),
     }
 }
 

@@ -103,6 +103,53 @@ pub(super) fn write_conoscope_png(run: &RunResult, path: &Path) -> Result<()> {
     write_polar(path, &grid, &opts)
 }
 
+/// `luminance.exr` and `luminance.png`: the luminance map within the detector's cone
+/// ([`metrics::cone`]); nothing without lumens or spectra.
+pub(super) fn write_luminance_map(run: &RunResult, staged: &SetDir) -> Result<()> {
+    let Some(map) = metrics::cone::luminance_cone_map(&run.scene, &run.tally) else {
+        return Ok(());
+    };
+    let cone = run.scene.detector.luminance_cone_deg;
+    let mut attrs = map_attributes(
+        run,
+        "cd/m^2",
+        "blutrace luminance map: Y = luminance (cd/m^2) of the light leaving each bin \
+         within luminance_cone_deg of the detector normal, stderr.Y = its standard error, \
+         hits.Y = photons in the cone per bin; x along detector_u, y along detector_v",
+    );
+    attrs.push(("luminance_cone_deg", Attribute::Text(cone.to_string())));
+    let (value, stderr, hits) = (f32s(&map.value), f32s(&map.stderr), counts(&map.hits));
+    staged.write_with("luminance.exr", |path| {
+        let channels = [
+            ("Y", Samples::F32(&value)),
+            ("stderr.Y", Samples::F32(&stderr)),
+            ("hits.Y", Samples::F32(&hits)),
+        ];
+        write_channels(path, map.nx, map.ny, &channels, &attrs)
+    })?;
+    let d = &run.scene.detector;
+    let grid = Grid {
+        nx: map.nx,
+        ny: map.ny,
+        values: &map.value,
+        x_mm: [0.0, d.size[0]],
+        y_mm: [0.0, d.size[1]],
+    };
+    let opts = MapOptions {
+        title: format!(
+            "{}: luminance within {cone} deg of the normal, {} photons",
+            run.scene.name,
+            thousands(run.tally.ledger.photons)
+        ),
+        x_label: "detector u (mm)".into(),
+        y_label: "detector v (mm)".into(),
+        unit: "luminance (cd/m²)".into(),
+        ..MapOptions::default()
+    };
+    staged.write_with("luminance.png", |path| write_map(path, &grid, &opts))?;
+    Ok(())
+}
+
 /// `flux.exr` of the map `flux`.
 pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Result<()> {
     let attrs = map_attributes(

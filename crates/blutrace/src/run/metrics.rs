@@ -11,6 +11,7 @@
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
 
 pub mod color;
+pub mod cone;
 mod jackknife;
 
 pub use jackknife::{
@@ -24,6 +25,15 @@ use serde::Serialize;
 
 /// Number of interleaved photon groups kept for jackknife errors.
 pub const GROUPS: usize = 32;
+
+/// A value and its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// Its standard error.
+    pub stderr: f64,
+}
 
 /// A map of values with standard errors and photon counts, row-major (x fastest).
 #[derive(Clone, Debug)]

@@ -281,9 +281,18 @@ pub const TALLY_BUDGET_BYTES: u64 = 4 << 30;
 pub fn tally_bytes(scene: &Scene) -> u64 {
     let d = &scene.detector;
     let bins = (d.bins[0] * d.bins[1] + d.angular_bins[0] * d.angular_bins[1]) as u64;
-    // Spectral scenes tally X, Y, Z beside the radiant weight.
+    // Spectral scenes tally X, Y, Z beside the radiant weight; with lumens or spectra
+    // the luminance cone's grid holds one more set of flux bins.
     let grids = if scene.sources.spectral() { 4 } else { 1 };
-    bins * grids * std::mem::size_of::<crate::tally::BinStats>() as u64 * (GROUPS as u64 + 1)
+    let luminous = scene.sources.spectral() || scene.sources.luminous_efficacy().is_some();
+    let cone = if luminous {
+        (d.bins[0] * d.bins[1]) as u64
+    } else {
+        0
+    };
+    (bins * grids + cone)
+        * std::mem::size_of::<crate::tally::BinStats>() as u64
+        * (GROUPS as u64 + 1)
 }
 
 /// [`tally_bytes`], or an error when over the budget.
@@ -462,6 +471,7 @@ impl RunResult {
         images::write_flux_exr(self, staged, &flux)?;
         images::write_angular_exr(self, staged)?;
         color_images::write_color_images(self, staged)?;
+        images::write_luminance_map(self, staged)?;
         staged.write_with("flux.png", |png| images::write_flux_png(self, png, &flux))?;
         staged.write_with("conoscope.png", |png| {
             images::write_conoscope_png(self, png)

@@ -1,6 +1,7 @@
 //! `summary.json`, `convergence.csv` and `convergence.png`.
 
 use super::metrics::color::{ColorSummary, color_summary};
+use super::metrics::cone::{LuminanceMapSummary, luminance_map_summary};
 use super::metrics::{Metric, MetricValues, Metrics, Uniformity};
 use super::{ConvergenceRow, RunResult, StoppedBy, TargetMetric, relative_error};
 use crate::optics::surface::Estimator;
@@ -67,6 +68,10 @@ pub struct Summary {
     pub figure_of_merit: FigureOfMerit,
     /// Luminance, when the sources give their lumens or spectra.
     pub luminance: Option<LuminanceSummary>,
+    /// The luminance map's mean and uniformity within the detector's luminance cone, when
+    /// the sources give their lumens or spectra ([`super::metrics::cone`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub luminance_map: Option<LuminanceMapSummary>,
     /// The target light's colour and colour uniformity, when the sources have spectra
     /// ([`super::metrics::color`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -292,6 +297,7 @@ impl RunResult {
                         .collect(),
                 }
             }),
+            luminance_map: luminance_map_summary(&self.scene, &self.tally, &self.groups),
             color: color_summary(&self.scene, &self.tally, &self.groups),
             detector: DetectorSummary {
                 origin_mm: (d.origin + self.scene.offset).to_array(),

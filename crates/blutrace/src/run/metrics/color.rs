@@ -14,6 +14,7 @@
 //! for the cv. Errors: delete-one-group jackknife over the run's photon groups, as
 //! for every non-linear metric ([`super::jackknife`]).
 
+pub use super::Estimate;
 use super::{Map, grid_map, jackknife_stderr, spot_mean, thirteen_points};
 use crate::color::{KM_LM_PER_W, UvPrime, Xyz, cct};
 use crate::scene::Scene;
@@ -27,15 +28,6 @@ pub fn xyz_maps(scene: &Scene, t: &Tally) -> Option<[Map; 3]> {
     Some(std::array::from_fn(|k| {
         grid_map(scene, t, &color.flux[k], |_| area_m2 / KM_LM_PER_W)
     }))
-}
-
-/// A value and its standard error.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Estimate {
-    /// The value.
-    pub value: f64,
-    /// Its standard error.
-    pub stderr: f64,
 }
 
 /// `summary.json`'s `color`: the target's colour and its non-uniformity.

@@ -1,0 +1,124 @@
+//! The luminance map: cd/m² per target bin of the light leaving it within the detector's
+//! luminance cone (`detector.luminance_cone_deg`, see [`crate::detector`]), as a
+//! luminance meter aimed at the panel reads it, and its uniformity as a display lab
+//! measures it (on luminance, not irradiance), with jackknife errors.
+//!
+//! ```toml
+//! [detector]
+//! luminance_cone_deg = 2.0   # the default
+//! ```
+//!
+//! `L = K P_cone / (A_bin pi sin^2(c))`: the luminous power within the cone over the bin's
+//! area and the cone's projected solid angle. `K P` is the Y tally's 683 lm/W times ȳ at
+//! each photon's wavelength in a spectral run, else the radiant power times the sources'
+//! given efficacy. For light whose luminance is constant within the cone (a diffuse
+//! panel near the normal) this is the luminance on the axis; a cone of the first theta
+//! row's width holds exactly the photons of that row, so the map's mean is then the
+//! angular output's on-axis luminance.
+
+use super::{Estimate, Map, Metric, Metrics, bin_value, jackknife_stderr};
+use crate::color::KM_LM_PER_W;
+use crate::scene::Scene;
+use crate::tally::{Grid, Sign, Tally};
+use serde::Serialize;
+
+/// The cone grid of `t` and the lumens per unit of its weight (`None`: no lumens or
+/// spectra).
+fn cone_grid<'t>(scene: &Scene, t: &'t Tally) -> Option<(&'t Grid, f64)> {
+    let g = t.cone.as_ref()?;
+    let efficacy = match &t.color {
+        Some(_) => KM_LM_PER_W,
+        None => scene.sources.luminous_efficacy()?,
+    };
+    Some((g, efficacy))
+}
+
+/// The luminance map of `grid` over `photons` photons (cd/m² per bin).
+fn map_of(scene: &Scene, grid: &Grid, photons: u64, efficacy: f64) -> Map {
+    let d = &scene.detector;
+    let per_bin = d.bin_area() * 1e-6 * d.cone_projected_solid_angle();
+    let k = scene.sources.total_power() * efficacy / per_bin;
+    let mut m = Map {
+        nx: grid.nx,
+        ny: grid.ny,
+        value: Vec::with_capacity(grid.bins.len()),
+        stderr: Vec::with_capacity(grid.bins.len()),
+        hits: Vec::with_capacity(grid.bins.len()),
+    };
+    for b in &grid.bins {
+        let (v, e) = bin_value(b, photons, k);
+        m.value.push(v);
+        m.stderr.push(e);
+        m.hits.push(b.hits);
+    }
+    m
+}
+
+/// The luminance map (cd/m² per bin), or `None` without lumens or spectra.
+pub fn luminance_cone_map(scene: &Scene, t: &Tally) -> Option<Map> {
+    let (g, efficacy) = cone_grid(scene, t)?;
+    Some(map_of(scene, g, t.ledger.photons, efficacy))
+}
+
+/// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LuminanceMapSummary {
+    /// Half-angle of the cone (degrees).
+    pub cone_deg: f64,
+    /// Mean luminance over the target (cd/m²).
+    pub mean_cd_m2: Estimate,
+    /// RMS deviation over mean of the map.
+    pub cv: Estimate,
+    /// The cv a perfectly uniform panel would show from noise alone.
+    pub cv_noise_floor: f64,
+    /// `sqrt(max(cv^2 - floor^2, 0))`.
+    pub cv_debiased: Estimate,
+    /// Smallest bin over largest.
+    pub min_over_max: Estimate,
+    /// Min over max of the 9 standard 3x3-bin spots.
+    pub nine_point_min_over_max: Estimate,
+    /// Min over max of the 13 standard spots.
+    pub thirteen_point_min_over_max: Estimate,
+}
+
+/// The luminance map's summary with jackknife errors over `groups` (`None` without
+/// lumens or spectra).
+pub fn luminance_map_summary(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+) -> Option<LuminanceMapSummary> {
+    let (grid, efficacy) = cone_grid(scene, total)?;
+    let n = total.ledger.photons;
+    let metrics = |m: &Map| Metrics::of_flux(m.nx, m.ny, &m.value, &m.stderr, f64::NAN);
+    let own = metrics(&map_of(scene, grid, n, efficacy));
+    let leave_out: Vec<Metrics> = groups
+        .iter()
+        .filter(|g| g.ledger.photons > 0)
+        .filter_map(|g| {
+            let mut rest = grid.clone();
+            rest.merge_signed(g.cone.as_ref()?, Sign::Remove);
+            Some(metrics(&map_of(
+                scene,
+                &rest,
+                n - g.ledger.photons,
+                efficacy,
+            )))
+        })
+        .collect();
+    let values = own.values();
+    let est = |m: Metric| Estimate {
+        value: values[m],
+        stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
+    };
+    Some(LuminanceMapSummary {
+        cone_deg: scene.detector.luminance_cone_deg,
+        mean_cd_m2: est(Metric::Mean),
+        cv: est(Metric::Cv),
+        cv_noise_floor: own.cv_noise_floor,
+        cv_debiased: est(Metric::CvDebiased),
+        min_over_max: est(Metric::MinOverMax),
+        nine_point_min_over_max: est(Metric::NinePoint),
+        thirteen_point_min_over_max: est(Metric::ThirteenPoint),
+    })
+}

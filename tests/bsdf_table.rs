@@ -698,3 +698,30 @@ fn the_bsdf_command_writes_a_table_the_model_reads() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("--aoi"), "{stderr}");
 }
+
+#[test]
+fn the_fuzz_seeds_build_and_the_bad_ones_fail() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/bsdf");
+    let mut seeds: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    seeds.sort();
+    assert!(seeds.len() >= 4, "{seeds:?}");
+    for path in seeds {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let channel = if text.contains("XYZ") {
+            "\ntristimulus = \"Y\""
+        } else {
+            ""
+        };
+        let spec = format!("model = \"bsdf_table\"\nfile = \"{name}\"\ninside = \"pet\"{channel}");
+        match (name.starts_with("bad-"), model(&spec, &[(&name, &text)])) {
+            (false, Ok(_)) => {}
+            (true, Err(e)) => assert!(format!("{e:#}").contains(&name), "{name}: {e:#}"),
+            (false, Err(e)) => panic!("{name} should build: {e:#}"),
+            (true, Ok(_)) => panic!("{name} should fail"),
+        }
+    }
+}

@@ -361,3 +361,60 @@ fn check_prints_the_ray_file() {
     set.rays.clear();
     assert!(json["sources"][0]["rayfile"].is_null());
 }
+
+/// The files of `fuzz/seeds/<target>`: (name, path), sorted.
+fn fuzz_seeds(target: &str) -> Vec<(String, std::path::PathBuf)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fuzz/seeds")
+        .join(target);
+    let mut out: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), p))
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn the_fuzz_seeds_read_and_the_bad_ones_fail() {
+    for target in ["tm25", "rayfile_text"] {
+        let seeds = fuzz_seeds(target);
+        assert!(seeds.len() >= 4, "{target}: {seeds:?}");
+        for (name, path) in seeds {
+            let read = RaySet::read(&path);
+            match (name.starts_with("bad-"), read) {
+                (false, Ok(set)) => assert!(set.total_flux() > 0.0, "{name}"),
+                (true, Err(e)) => assert!(format!("{e:#}").contains(&name), "{name}: {e:#}"),
+                (false, Err(e)) => panic!("{target}/{name} should read: {e:#}"),
+                (true, Ok(set)) => panic!("{target}/{name} should fail: {set:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn a_ray_file_with_wavelengths_makes_the_media_spectral() {
+    // No `spectrum` key anywhere: the file's nm column alone makes the scene spectral, so
+    // the particles are tabulated over wavelength (found by the fuzz target `rayfile_text`,
+    // whose debug build asserted the scene's two views of it agree).
+    let rays = "0 0 0  0 0 1  0.5 450\n0.5 0 0  0 0 1  0.5 650\n";
+    let medium = "[media.milk]\nn = 1.49\n\
+        particles = { radius_um = 1.0, n = 1.42, volume_fraction = 0.01, wavelength_nm = 480.0 }\n";
+    let scene = two_colour_scene("spectral-media", rays, medium);
+    assert!(scene.sources.spectral());
+    let milk = scene.media.iter().find(|m| m.name == "milk").unwrap();
+    assert!(
+        milk.scattering.per_mm.is_spectral(),
+        "{:?}",
+        milk.scattering
+    );
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("media.milk.particles.wavelength_nm = 480 is not used")),
+        "{:?}",
+        scene.warnings
+    );
+}

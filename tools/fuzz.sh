@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzz blutrace's input loaders with cargo-fuzz (libFuzzer): every target in fuzz/ (scene
-# TOML, OBJ, glTF/GLB, STL, PLY, IES, CSV intensity tables, shard JSON; see
-# fuzz/README.md) runs for SECONDS each, one after the other. Not part of CI (.ci/run and
+# TOML, OBJ, glTF/GLB, STL, PLY, IES, CSV intensity tables, shard JSON, TM-25 and text
+# ray files, IS BSDF tables; see fuzz/README.md) runs for SECONDS each, one after the other. Not part of CI (.ci/run and
 # tools/test.sh never call it); run it by hand:
 #
 #   bash tools/fuzz.sh [SECONDS_PER_TARGET] [TARGET ...]   # default 60 s, all targets

@@ -21,6 +21,12 @@ pub const MESH_SCENE: &str = include_str!("../../fixtures/mesh-scene.toml");
 /// The scene the intensity targets load (`@FILE@` filled in).
 pub const INTENSITY_SCENE: &str = include_str!("../../fixtures/intensity-scene.toml");
 
+/// The scene the ray file targets load (`@FILE@` filled in).
+pub const RAYFILE_SCENE: &str = include_str!("../../fixtures/rayfile-scene.toml");
+
+/// The scene the bsdf target loads (`@FILE@`, `@TRISTIMULUS@` filled in).
+pub const BSDF_SCENE: &str = include_str!("../../fixtures/bsdf-scene.toml");
+
 static DIR: OnceLock<PathBuf> = OnceLock::new();
 
 /// This process's scratch folder, created on first use with the files of the fixture
@@ -136,3 +142,101 @@ pub fn intensity_case(target: &str, name: &str, data: &[u8]) {
 
 /// test/slab's box (tags lgp_front, lgp_back, lgp_edge).
 pub const SLAB_OBJ: &str = include_str!("../../fixtures/scene/slab.obj");
+
+/// Photons emitted, or BSDF samples drawn per angle, from a scene that loaded.
+const DRAWS: u64 = 16;
+
+/// Whether `d` is a finite unit vector.
+fn unit(d: glam::DVec3) -> bool {
+    d.is_finite() && (d.length() - 1.0).abs() < 1e-6
+}
+
+/// A ray file target: the input is the ray file `name` (`led.TM25RAY` or `led.txt`) of
+/// the fixed slab scene (fuzz/fixtures/rayfile-scene.toml), loaded whole by `Scene::load`
+/// (reader, placement and lamp checks, alias table, spectrum); a scene that loads emits
+/// a few photons, each of which must start at a finite point with a unit direction and,
+/// in a spectral scene, a wavelength within 360-830 nm.
+pub fn rayfile_case(target: &str, name: &str, data: &[u8]) {
+    let scene = RAYFILE_SCENE.replace("@FILE@", name);
+    let dir = workdir(
+        target,
+        &[],
+        &[("scene.toml", &scene), ("slab.obj", SLAB_OBJ)],
+    );
+    put(dir, name, data);
+    let loaded = Scene::load(&dir.join("scene.toml"));
+    report("scene", &loaded);
+    let Ok(scene) = loaded else {
+        return;
+    };
+    let (lo, hi) = blutrace::sources::spectrum::VISIBLE_NM;
+    for i in 0..DRAWS {
+        let mut rng = blutrace::rng::PhotonRng::new(1, i);
+        let e = scene.sources.sample(&mut rng);
+        let (o, d) = (e.ray.origin, e.ray.dir);
+        assert!(o.is_finite() && unit(d), "photon {i}: from {o} along {d}");
+        let nm = e.light.nm();
+        let ok = (lo..=hi).contains(&nm) || !scene.sources.spectral();
+        assert!(ok, "photon {i}: wavelength {nm} nm");
+    }
+}
+
+/// The bsdf target: the input is the IS BSDF file `t.bsdf` scattering on the back face of
+/// the fixed slab scene (fuzz/fixtures/bsdf-scene.toml; `tristimulus = "Y"` when the input
+/// names XYZ), loaded whole by `Scene::load` (parser, tables, TIS checks); a table that
+/// loads is sampled at a few angles of incidence from both sides, and every scattered
+/// direction must be a finite unit vector with a finite weight within [0, 1].
+pub fn bsdf_case(target: &str, data: &[u8]) {
+    let xyz = data.windows(3).any(|w| w.eq_ignore_ascii_case(b"xyz"));
+    let channel = if xyz { "tristimulus = \"Y\"" } else { "" };
+    let scene = BSDF_SCENE
+        .replace("@FILE@", "t.bsdf")
+        .replace("@TRISTIMULUS@", channel);
+    let dir = workdir(target, &[], &[("slab.obj", SLAB_OBJ)]);
+    std::fs::write(dir.join("scene.toml"), scene).expect("write the scene");
+    put(dir, "t.bsdf", data);
+    let loaded = Scene::load(&dir.join("scene.toml"));
+    report("scene", &loaded);
+    if let Ok(scene) = loaded {
+        scatter_back_face(&scene);
+    }
+}
+
+/// Photons arriving at the slab's back face (tag `lgp_back`) at 0-89 degrees, from air
+/// below and from the PMMA above, scattered by its model.
+fn scatter_back_face(scene: &Scene) {
+    let tag = scene.tags.iter().position(|t| t == "lgp_back");
+    let pmma = scene.media.iter().position(|m| m.name == "pmma");
+    let (Some(tag), Some(pmma)) = (tag, pmma) else {
+        panic!("the fixture scene has lgp_back and pmma");
+    };
+    for deg in [0.0f64, 30.0, 60.0, 89.0] {
+        let (s, c) = deg.to_radians().sin_cos();
+        scatter_from(scene, tag, glam::DVec3::new(s, 0.0, c), 0);
+        scatter_from(scene, tag, glam::DVec3::new(s, 0.0, -c), pmma as u16);
+    }
+}
+
+/// [`DRAWS`] photons along `dir` in medium `medium` meeting the back face (normal -z) of
+/// tag `tag`, analog and weighted: every one that leaves goes along a unit direction with
+/// a weight within [0, 1].
+fn scatter_from(scene: &Scene, tag: usize, dir: glam::DVec3, medium: u16) {
+    use blutrace::estimator::Estimator;
+    use blutrace::optics::surface::Outcome;
+    let hit = blutrace::geometry::SurfaceHit {
+        t: 1.0,
+        prim: 0,
+        point: glam::DVec3::new(10.0, 10.0, 0.0),
+        normal: -glam::DVec3::Z,
+    };
+    for est in [Estimator::Analog, Estimator::Weighted] {
+        for i in 0..DRAWS {
+            let mut rng = blutrace::rng::PhotonRng::new(2, i);
+            let out = scene.surfaces[tag].interact(&scene.media, &hit, dir, medium, est, &mut rng);
+            if let Outcome::Scattered { dir: d, weight, .. } = out {
+                let w_ok = weight.is_finite() && (0.0..=1.0 + 1e-9).contains(&weight);
+                assert!(unit(d) && w_ok, "from {dir}: to {d}, weight {weight}");
+            }
+        }
+    }
+}

@@ -125,14 +125,19 @@ impl Scene {
         }
         let mut warnings = Vec::new();
         // A spectral scene's particles scatter over wavelength (Mie tabulated at load).
-        let spectral = file.sources.iter().any(SourceSpec::has_spectrum);
+        let keyed = file.sources.iter().any(SourceSpec::has_spectrum);
+        let mut media = medium::build_media(&ctx, &file.media, keyed)?;
+        // Sources first: procedural reflectors follow the lamps.
+        let sources = Sources::build(&ctx, &file.sources, &media)?;
+        // A ray file's wavelengths make a scene spectral without any `spectrum` key: the
+        // media are built again, over wavelength (the same media, so the same ids).
+        let spectral = sources.spectral();
+        if spectral != keyed {
+            media = medium::build_media(&ctx, &file.media, spectral)?;
+        }
         if spectral {
             warnings.extend(medium::spectral_warnings(&file.media));
         }
-        let media = medium::build_media(&ctx, &file.media, spectral)?;
-        // Sources first: procedural reflectors follow the lamps.
-        let sources = Sources::build(&ctx, &file.sources, &media)?;
-        debug_assert_eq!(spectral, sources.spectral());
         let (mut mesh, tags, geometry) =
             load_geometry(&ctx, file, path, &sources.list, &mut warnings, reads)?;
         let (mut surfaces, mut backs) = (Vec::new(), Vec::new());

@@ -327,9 +327,9 @@ fn read_tables(
     let (mut brdf, mut btdf): (Loaded, Loaded) = (None, None);
     for f in files {
         let path = dir.join(f);
-        let text = crate::input_file::read_text(&path, "BSDF table")
-            .map_err(|e| ctx.err(field, format!("{e:#}")))?;
-        for sec in format::parse(&text, &path)? {
+        let in_field = |e: anyhow::Error| ctx.err(field, format!("{e:#}"));
+        let text = crate::input_file::read_text(&path, "BSDF table").map_err(in_field)?;
+        for sec in format::parse(&text, &path).map_err(in_field)? {
             if !traced_channel(ctx, at, &path, sec.channel, channel)? {
                 continue;
             }
@@ -348,7 +348,8 @@ fn read_tables(
                     ),
                 ));
             }
-            *slot = Some((path.clone(), Arc::new(Table::new(&sec, &path)?)));
+            let table = Table::new(&sec, &path).map_err(in_field)?;
+            *slot = Some((path.clone(), Arc::new(table)));
         }
     }
     Ok((brdf, btdf))

@@ -238,3 +238,25 @@ fn the_alias_table_draws_in_proportion_to_flux() {
         );
     }
 }
+
+#[test]
+fn text_rays_stop_at_the_cap_naming_the_line() {
+    let text = "# three rays\n0 0 0 0 0 1 1\n\n0 0 0 0 0 1 1\n0 0 0 0 0 1 1\n";
+    let read = |cap| text::read_rows(text.as_bytes(), "big.txt", cap);
+    assert_eq!(read(3).unwrap().rays.len(), 3);
+    let e = format!("{:#}", read(2).unwrap_err());
+    assert!(
+        e.contains("big.txt: line 5: more than 2 rays"),
+        "want the file, the line and the cap in: {e}"
+    );
+    assert_eq!(text::MAX_RAYS, 76_694_548);
+    let long = format!("0 0 0 0 0 1 1 #{}\n", "x".repeat(text::MAX_LINE_BYTES));
+    let e = format!(
+        "{:#}",
+        text::read_rows(long.as_bytes(), "long.txt", 9).unwrap_err()
+    );
+    assert!(
+        e.contains("long.txt: line 1: longer than 65536 bytes"),
+        "{e}"
+    );
+}

@@ -34,6 +34,8 @@
 //! compact [`RaySet`]; the file is never held whole in memory.
 
 use super::{FileSpectrum, FluxUnit, RaySet, StoredRay, TEXT_FIELDS, check_ray, checked_len};
+use crate::input_file::MAX_INPUT_BYTES;
+use crate::sources::spectrum::VISIBLE_NM;
 use anyhow::{Result, bail};
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::Path;
@@ -48,6 +50,11 @@ const TABLES_AT: u64 = (HEADER_BYTES + 32 + 9 * TEXT_BYTES) as u64;
 const COLUMN_NAME_BYTES: u64 = 512;
 /// Rays read per chunk.
 const CHUNK_RAYS: usize = 1 << 16;
+/// Bytes of the smallest ray record: x y z kx ky kz and one flux, f32 each.
+const MIN_RECORD_BYTES: u64 = 28;
+/// Most rays a TM-25 file read can hold: the ray count must fill the file exactly, and
+/// the file may hold at most [`MAX_INPUT_BYTES`] (76,694,548 rays of 28 bytes).
+pub const MAX_RAYS: usize = ((MAX_INPUT_BYTES - TABLES_AT) / MIN_RECORD_BYTES) as usize;
 
 /// Names of the known data flags (4.7.2.1 to 4.7.2.8).
 const FLAG_NAMES: [&str; 8] = [
@@ -201,13 +208,14 @@ fn check_header(path: &Path, h: &Header) -> Result<()> {
             "must be 1 when the spectral data identifier is 2 (TM-25-13 4.7.2.5)",
         ));
     }
-    if h.identifier == 1 && !(h.single_nm.is_finite() && h.single_nm > 0.0) {
+    let (lo, hi) = VISIBLE_NM;
+    if h.identifier == 1 && !(lo..=hi).contains(&(h.single_nm as f64)) {
         return Err(bad(
             path,
             64,
             "single wavelength (4.7.1.10)",
             format!(
-                "must be > 0 nm for spectral data identifier 1, got {}",
+                "must be within {lo}-{hi} nm for spectral data identifier 1, got {}",
                 h.single_nm
             ),
         ));

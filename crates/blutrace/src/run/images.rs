@@ -46,26 +46,36 @@ use std::path::Path;
 /// `flux.png`: the map `flux` over the detector, titled with the scene, photons and
 /// extraction efficiency.
 pub(super) fn write_flux_png(run: &RunResult, path: &Path, flux: &Map) -> Result<()> {
-    let d = &run.scene.detector;
     let l = &run.tally.ledger;
     let (efficiency, _) = l.detected.mean_and_stderr(l.photons);
-    let grid = Grid {
-        nx: flux.nx,
-        ny: flux.ny,
-        values: &flux.value,
+    let title = format!(
+        "{}: {} photons, extraction efficiency {:.2} %",
+        run.scene.name,
+        thousands(l.photons),
+        100.0 * efficiency
+    );
+    write_target_png(path, map_on_target(run, flux), title, "irradiance (W/mm²)")
+}
+
+/// A map of the detector's bins, over the target in mm.
+fn map_on_target<'m>(run: &RunResult, map: &'m Map) -> Grid<'m> {
+    let d = &run.scene.detector;
+    Grid {
+        nx: map.nx,
+        ny: map.ny,
+        values: &map.value,
         x_mm: [0.0, d.size[0]],
         y_mm: [0.0, d.size[1]],
-    };
+    }
+}
+
+/// A false-colour PNG of `grid` over the target, axes along the detector's u and v.
+fn write_target_png(path: &Path, grid: Grid, title: String, unit: &str) -> Result<()> {
     let opts = MapOptions {
-        title: format!(
-            "{}: {} photons, extraction efficiency {:.2} %",
-            run.scene.name,
-            thousands(l.photons),
-            100.0 * efficiency
-        ),
+        title,
         x_label: "detector u (mm)".into(),
         y_label: "detector v (mm)".into(),
-        unit: "irradiance (W/mm²)".into(),
+        unit: unit.into(),
         ..MapOptions::default()
     };
     write_map(path, &grid, &opts)
@@ -127,26 +137,15 @@ pub(super) fn write_luminance_map(run: &RunResult, staged: &SetDir) -> Result<()
         ];
         write_channels(path, map.nx, map.ny, &channels, &attrs)
     })?;
-    let d = &run.scene.detector;
-    let grid = Grid {
-        nx: map.nx,
-        ny: map.ny,
-        values: &map.value,
-        x_mm: [0.0, d.size[0]],
-        y_mm: [0.0, d.size[1]],
-    };
-    let opts = MapOptions {
-        title: format!(
-            "{}: luminance within {cone} deg of the normal, {} photons",
-            run.scene.name,
-            thousands(run.tally.ledger.photons)
-        ),
-        x_label: "detector u (mm)".into(),
-        y_label: "detector v (mm)".into(),
-        unit: "luminance (cd/m²)".into(),
-        ..MapOptions::default()
-    };
-    staged.write_with("luminance.png", |path| write_map(path, &grid, &opts))?;
+    let title = format!(
+        "{}: luminance within {cone} deg of the normal, {} photons",
+        run.scene.name,
+        thousands(run.tally.ledger.photons)
+    );
+    let unit = "luminance (cd/m²)";
+    staged.write_with("luminance.png", |path| {
+        write_target_png(path, map_on_target(run, &map), title.clone(), unit)
+    })?;
     Ok(())
 }
 

@@ -59,6 +59,11 @@ impl ScatterType {
     }
 }
 
+/// The largest BSDF value read (1/sr). A specular peak holding all of the power in a cell
+/// of 0.01 degrees reaches about 1e7; far larger values are a damaged file, and would
+/// overflow the sampler's running sums of value times solid angle.
+pub const MAX_BSDF: f64 = 1e12;
+
 /// A tristimulus channel of an XYZ table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 pub enum Channel {
@@ -393,8 +398,11 @@ fn block(w: &mut Words, (rot, aoi): (f64, f64), n_az: usize, n_rad: usize) -> Re
     for row in values.iter_mut() {
         for v in row.iter_mut() {
             let (x, line) = w.number(&format!("BSDF value of {here}"))?;
-            if x < 0.0 {
-                return Err(w.err_at(line, format!("BSDF value {x} of {here} is negative")));
+            if !(0.0..=MAX_BSDF).contains(&x) {
+                return Err(w.err_at(
+                    line,
+                    format!("BSDF value {x:e} of {here} is outside [0, {MAX_BSDF:e}] (1/sr)"),
+                ));
             }
             *v = x;
         }
@@ -564,7 +572,11 @@ mod tests {
             ),
             (
                 GOOD.replace("0.1 0.1 0.1\nDataEnd", "0.1 -0.1 0.1\nDataEnd"),
-                "line 22: BSDF value -0.1",
+                "line 22: BSDF value -1e-1 of rotation 0, AOI 60 is outside [0, 1e12]",
+            ),
+            (
+                GOOD.replace("0.1 0.1 0.1\nDataEnd", "0.1 1e300 0.1\nDataEnd"),
+                "line 22: BSDF value 1e300",
             ),
             (
                 GOOD.replace("0.1 0.1 0.1\nDataEnd", "0.1 x 0.1\nDataEnd"),

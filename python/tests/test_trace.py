@@ -161,3 +161,12 @@ def test_a_panic_in_rust_is_an_exception_not_a_crash():
     with pytest.raises(bt.BlutraceError, match="internal error.*deliberate panic"):
         bt._native._panic_on_worker()
     assert bt.Scene is not None  # the interpreter goes on
+
+
+def test_a_scene_with_lumens_has_a_luminance_map_and_power_per_source(phone):
+    s = phone.trace(photons=20_000, seed=2).summary
+    m = s["luminance_map"]
+    assert m["cone_deg"] == 2.0 and m["mean_cd_m2"]["stderr"] > 0.0
+    by_source = s["ledger"]["detected_by_source_w"]
+    assert len(by_source) == 6
+    assert sum(b["w"] for b in by_source) == pytest.approx(s["ledger"]["detected_w"], rel=1e-12)

@@ -551,20 +551,7 @@ fn check_prints_sizes_and_json() {
     let geometry = "file = \"part.stl\"\ntag = \"lgp\"\nunits = \"cm\"\nscale = 0.1";
     let dir = write_scene("cad-check", &scene_toml(geometry), &[]);
     std::fs::write(dir.parent().unwrap().join("part.stl"), stl_binary(&tris)).unwrap();
-    let run = |json: bool| {
-        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"));
-        cmd.arg("check").arg(&*dir);
-        if json {
-            cmd.arg("--json");
-        }
-        let out = cmd.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8(out.stdout).unwrap()
-    };
+    let run = |json: bool| check_output(&dir, json);
     let text = run(false);
     assert!(
         text.contains("file part.stl") && text.contains("125.000 x 62.500 x 3.906 mm"),

@@ -15,7 +15,7 @@ use blutrace::sources::Emitter;
 use blutrace::sources::rayfile::{FileSpectrum, FluxUnit, RaySet, StoredRay, check_ray, tm25};
 use glam::DVec3;
 use std::path::Path;
-use support::{assert_balanced, load, temp_folder, trace, write_scene};
+use support::{assert_balanced, check_output, load, temp_folder, trace, write_scene};
 
 /// The bundled phone-led scene with cos^3 LEDs (no intensity table) copied into `dir`.
 fn cos_led_scene(dir: &Path) -> String {
@@ -328,20 +328,7 @@ fn check_prints_the_ray_file() {
     std::fs::write(dir.path().join("mirror.obj"), MIRROR).unwrap();
     let toml = scene_two_sources("", "").replace("two.rays", "x.TM25RAY");
     std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
-    let run = |json: bool| {
-        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"));
-        cmd.arg("check").arg(dir.path().join("scene.toml"));
-        if json {
-            cmd.arg("--json");
-        }
-        let out = cmd.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8(out.stdout).unwrap()
-    };
+    let run = |json: bool| check_output(&dir.path().join("scene.toml"), json);
     let text = run(false);
     for want in [
         "ray file x.TM25RAY: 2 rays, total 2.000000 W",

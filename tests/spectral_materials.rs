@@ -7,12 +7,11 @@
 
 mod support;
 
-use blutrace::accel::BackendChoice;
 use blutrace::optics::medium::Medium;
 use blutrace::optics::mie;
 use blutrace::optics::spectrum::{Light, Spectral};
 use blutrace::optics::surface::Estimator;
-use blutrace::run::{RunOptions, RunResult};
+use blutrace::run::RunResult;
 use blutrace::scene::Scene;
 use blutrace::tally::Ledger;
 use num_complex::Complex64;
@@ -45,38 +44,6 @@ fn beam(center: [f64; 3], normal: [f64; 3], u: [f64; 3], extra: &str) -> String 
          width_mm = 1e-3\nheight_mm = 1e-3\npower_w = 1.0\ncos_exponent = 1e9\n\
          body = \"transparent\"\n{extra}\n"
     )
-}
-
-fn run(scene: &Scene, photons: u64, seed: u64, estimator: Estimator) -> RunResult {
-    let r = trace_opts(
-        scene,
-        &RunOptions {
-            photons,
-            seed,
-            threads: Some(2),
-            backend: BackendChoice::Bvh,
-            estimator,
-            ..RunOptions::default()
-        },
-    );
-    assert_balanced(&r);
-    r
-}
-
-/// The fraction of the emitted power `f` picks out of a ledger, and its standard error
-/// from the spread of the run's photon groups.
-fn fraction(r: &RunResult, f: &dyn Fn(&Ledger) -> f64) -> (f64, f64) {
-    let l = &r.tally.ledger;
-    let parts: Vec<f64> = r
-        .groups
-        .iter()
-        .filter(|g| g.ledger.photons > 0)
-        .map(|g| f(&g.ledger) / g.ledger.photons as f64)
-        .collect();
-    let k = parts.len() as f64;
-    let mean = parts.iter().sum::<f64>() / k;
-    let var = parts.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (k - 1.0);
-    (f(l) / l.photons as f64, (var / k).sqrt())
 }
 
 /// Picks a power out of a ledger.
@@ -164,7 +131,7 @@ fn a_pmma_prism_disperses_blue_and_red_as_snell_and_sellmeier_say() {
     let mut seen = Vec::new();
     for nm in [450.0, 650.0] {
         let dir = prism_scene(nm, PMMA_SELLMEIER);
-        let r = run(&load(&dir), 4000, 11, Estimator::Analog);
+        let r = trace_balanced(&load(&dir), 4000, 11, Estimator::Analog);
         let (got, want) = (traced_deviation_deg(&r), snell_deviation_deg(pmma_n(nm)));
         eprintln!("{nm} nm: traced {got:.4} deg, Snell {want:.4} deg");
         assert!(
@@ -386,8 +353,8 @@ fn an_absorption_table_attenuates_each_wavelength_as_beer_lambert_says() {
         (690.0, 0.3_f64),
     ] {
         let dir = slab("beer", medium, &narrow_band(nm));
-        let r = run(&load(&dir), 2000, 5, Estimator::Weighted);
-        let (t, _) = fraction(&r, &|l| l.detected.sum.value());
+        let r = trace_balanced(&load(&dir), 2000, 5, Estimator::Weighted);
+        let (t, _) = ledger_fraction(&r, &|l| l.detected.sum.value());
         let want = (-a).exp();
         assert!(
             (t / want - 1.0).abs() < 1e-4,
@@ -404,8 +371,8 @@ fn a_broad_spectrum_transmits_the_mean_of_beer_lambert_over_it() {
     let medium = "n = 1.0\nabsorption_per_mm = { table = [[400, 2.0], [550, 1.0], [700, 0.25]] }";
     let source = "spectrum = { table = [[400, 1.0], [700, 1.0]] }";
     let dir = slab("beer-broad", medium, source);
-    let r = run(&load(&dir), 200_000, 9, Estimator::Analog);
-    let (t, err) = fraction(&r, &|l| l.detected.sum.value());
+    let r = trace_balanced(&load(&dir), 200_000, 9, Estimator::Analog);
+    let (t, err) = ledger_fraction(&r, &|l| l.detected.sum.value());
     // The mean of exp(-a) over a segment where a goes linearly from a0 to a1.
     let seg = |a0: f64, a1: f64| ((-a1).exp() - (-a0).exp()) / (a0 - a1);
     let want = 0.5 * seg(2.0, 1.0) + 0.5 * seg(1.0, 0.25);
@@ -459,15 +426,15 @@ fn narrow_band_against_monochrome(nm: f64) {
     let spectral = slab("narrow", &bead_slab_medium(true, nm), &narrow_band(nm));
     let mono = slab("mono", &bead_slab_medium(false, nm), "");
     let (rs, rm) = (
-        run(&load(&spectral), photons, 21, Estimator::Analog),
-        run(&load(&mono), photons, 22, Estimator::Analog),
+        trace_balanced(&load(&spectral), photons, 21, Estimator::Analog),
+        trace_balanced(&load(&mono), photons, 22, Estimator::Analog),
     );
     let ledgers: [(&str, Pick); 2] = [
         ("reflected", &|l: &Ledger| l.escaped.value()),
         ("transmitted", &|l: &Ledger| l.detected.sum.value()),
     ];
     for (what, f) in ledgers {
-        let ((a, ea), (b, eb)) = (fraction(&rs, f), fraction(&rm, f));
+        let ((a, ea), (b, eb)) = (ledger_fraction(&rs, f), ledger_fraction(&rm, f));
         let z = (a - b) / (ea * ea + eb * eb).sqrt();
         eprintln!(
             "{nm} nm, {what}: narrow band {a:.5} ± {ea:.1e}, monochrome {b:.5} ± {eb:.1e} ({z:.1} sigma)"

@@ -18,7 +18,6 @@ use blutrace::optics::spectrum::Spectral;
 use blutrace::optics::surface::Estimator;
 use blutrace::run::{RunOptions, RunResult};
 use blutrace::scene::Scene;
-use blutrace::tally::Ledger;
 use support::*;
 
 /// A slab of index `n`, thickness `thick`, in air, with medium lines `medium` (absorption,
@@ -54,44 +53,12 @@ fn medium_id(r: &RunResult, name: &str) -> usize {
     r.scene.media.iter().position(|m| m.name == name).unwrap()
 }
 
-/// The fraction of the emitted power `f` picks out of a ledger, and its standard error
-/// from the spread of the run's 32 photon groups.
-fn fraction(r: &RunResult, f: &dyn Fn(&Ledger) -> f64) -> (f64, f64) {
-    let l = &r.tally.ledger;
-    let all = f(l) / l.photons as f64;
-    let parts: Vec<f64> = r
-        .groups
-        .iter()
-        .map(|g| f(&g.ledger) / g.ledger.photons as f64)
-        .collect();
-    let k = parts.len() as f64;
-    let mean = parts.iter().sum::<f64>() / k;
-    let var = parts.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (k - 1.0);
-    (all, (var / k).sqrt())
-}
-
 /// Total reflection (escaped) and total transmission (detected below).
 fn reflection_transmission(r: &RunResult) -> [(f64, f64); 2] {
     [
-        fraction(r, &|l| l.escaped.value()),
-        fraction(r, &|l| l.detected.sum.value()),
+        ledger_fraction(r, &|l| l.escaped.value()),
+        ledger_fraction(r, &|l| l.detected.sum.value()),
     ]
-}
-
-fn run(scene: &Scene, photons: u64, seed: u64, estimator: Estimator) -> RunResult {
-    let r = trace_opts(
-        scene,
-        &RunOptions {
-            photons,
-            seed,
-            threads: Some(2),
-            backend: BackendChoice::Bvh,
-            estimator,
-            ..RunOptions::default()
-        },
-    );
-    assert_balanced(&r);
-    r
 }
 
 fn assert_near(what: &str, (got, err): (f64, f64), want: f64, z: f64) {
@@ -135,7 +102,7 @@ fn unscattered_transmission_is_exp_minus_mu_t_l() {
         };
         let r = trace_opts(&scene, &opts);
         assert_balanced(&r);
-        let got = fraction(&r, &|l| l.detected.sum.value());
+        let got = ledger_fraction(&r, &|l| l.detected.sum.value());
         assert_near(
             &format!("{estimator:?}, convex {convex}: unscattered"),
             got,
@@ -151,7 +118,7 @@ fn without_absorption_the_medium_absorbs_exactly_nothing() {
     let path = slab("lossless", 1.49, 1.0, medium, None);
     let scene = load(&path);
     for estimator in [Estimator::Analog, Estimator::Weighted] {
-        let r = run(&scene, 20_000, 2, estimator);
+        let r = trace_balanced(&scene, 20_000, 2, estimator);
         let slab = medium_id(&r, "slab");
         let l = &r.tally.ledger;
         assert_eq!(l.absorbed_in_medium[slab].value(), 0.0, "{estimator:?}");
@@ -171,7 +138,7 @@ fn index_matched_isotropic_slab_matches_adding_doubling() {
     let medium = "absorption_per_mm = 0.2\nscattering_per_mm = 0.8";
     let path = slab("iso", 1.0, 1.0, medium, None);
     let scene = load(&path);
-    let r = run(&scene, 200_000, 7, Estimator::Analog);
+    let r = trace_balanced(&scene, 200_000, 7, Estimator::Analog);
     let [refl, trans] = reflection_transmission(&r);
     assert_near("isotropic UR1", refl, 0.21085, 4.5);
     assert_near("isotropic UT1", trans, 0.54140, 4.5);
@@ -182,7 +149,7 @@ fn index_matched_forward_scattering_slab_matches_adding_doubling() {
     let medium = "absorption_per_mm = 0.2\nscattering_per_mm = 0.8\nanisotropy = 0.8";
     let path = slab("hg", 1.0, 1.0, medium, None);
     let scene = load(&path);
-    let r = run(&scene, 200_000, 8, Estimator::Weighted);
+    let r = trace_balanced(&scene, 200_000, 8, Estimator::Weighted);
     let [refl, trans] = reflection_transmission(&r);
     assert_near("g = 0.8 UR1", refl, 0.03041, 4.5);
     assert_near("g = 0.8 UT1", trans, 0.76388, 4.5);
@@ -268,8 +235,8 @@ fn fresnel_bounded_slab_matches_an_independent_slab_monte_carlo_with_both_estima
     let medium = "absorption_per_mm = 0.5\nscattering_per_mm = 0.5\nanisotropy = 0.9";
     let path = slab("fresnel", 1.4, 1.0, medium, None);
     let scene = load(&path);
-    let analog = run(&scene, 200_000, 9, Estimator::Analog);
-    let weighted = run(&scene, 200_000, 9, Estimator::Weighted);
+    let analog = trace_balanced(&scene, 200_000, 9, Estimator::Analog);
+    let weighted = trace_balanced(&scene, 200_000, 9, Estimator::Weighted);
     let beside = medium_id(&analog, "beside");
     let agree = |what: &str, (x, ex): (f64, f64), (y, ey): (f64, f64)| {
         eprintln!("{what}: {x:.5} ± {ex:.1e} vs {y:.5} ± {ey:.1e}");
@@ -452,7 +419,7 @@ fn a_phase_table_of_henyey_greenstein_gives_the_same_slab() {
         "{}",
         m.scattering.anisotropy
     );
-    let r = run(&scene, 200_000, 8, Estimator::Weighted);
+    let r = trace_balanced(&scene, 200_000, 8, Estimator::Weighted);
     let [refl, trans] = reflection_transmission(&r);
     assert_near("table UR1", refl, 0.03041, 4.5);
     assert_near("table UT1", trans, 0.76388, 4.5);

@@ -122,6 +122,62 @@ pub fn trace_opts(scene: &Scene, opts: &RunOptions) -> RunResult {
     run::trace(scene, opts, &|_| {}).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
+/// Trace on two threads with the BVH backend and `estimator`, and check that the ledger
+/// balances.
+pub fn trace_balanced(
+    scene: &Scene,
+    photons: u64,
+    seed: u64,
+    estimator: blutrace::optics::surface::Estimator,
+) -> RunResult {
+    let r = trace_opts(
+        scene,
+        &RunOptions {
+            photons,
+            seed,
+            threads: Some(2),
+            backend: BackendChoice::Bvh,
+            estimator,
+            ..RunOptions::default()
+        },
+    );
+    assert_balanced(&r);
+    r
+}
+
+/// The fraction of the emitted power `f` picks out of a run's ledger, and its standard
+/// error from the spread of the run's photon groups (those holding photons).
+pub fn ledger_fraction(r: &RunResult, f: &dyn Fn(&blutrace::tally::Ledger) -> f64) -> (f64, f64) {
+    let l = &r.tally.ledger;
+    let parts: Vec<f64> = r
+        .groups
+        .iter()
+        .filter(|g| g.ledger.photons > 0)
+        .map(|g| f(&g.ledger) / g.ledger.photons as f64)
+        .collect();
+    let k = parts.len() as f64;
+    let mean = parts.iter().sum::<f64>() / k;
+    let var = parts.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    (f(l) / l.photons as f64, (var / k).sqrt())
+}
+
+/// What `blutrace check SCENE` (with `--json` when `json`) prints; panics, showing its
+/// stderr, when it fails.
+pub fn check_output(scene: &Path, json: bool) -> String {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"));
+    cmd.arg("check").arg(scene);
+    if json {
+        cmd.arg("--json");
+    }
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
 /// Assert that the ledger balances exactly (every photon has one fate).
 pub fn assert_balanced(r: &RunResult) {
     let l = &r.tally.ledger;

@@ -217,12 +217,9 @@ impl GeometrySpec {
 
 /// A user's 4 x 4 row-major matrix as a transform: finite, affine, not singular; a warning
 /// when it is not a rotation times a uniform scale.
-fn checked_matrix(
-    ctx: &Ctx,
-    field: &str,
-    m: [[f64; 4]; 4],
-    warnings: &mut Vec<String>,
-) -> Result<DMat4> {
+/// A scene file's row-major 4 x 4 `matrix` (at `field`) as an affine transform: every
+/// entry finite, the last row [0, 0, 0, 1]. Geometry files and ray files are placed by it.
+pub(crate) fn affine_matrix(ctx: &Ctx, field: &str, m: [[f64; 4]; 4]) -> Result<DMat4> {
     for (r, row) in m.iter().enumerate() {
         for (c, x) in row.iter().enumerate() {
             ctx.finite(&format!("{field}[{r}][{c}]"), *x)?;
@@ -235,7 +232,16 @@ fn checked_matrix(
         ));
     }
     // glam stores columns: the transpose of the row-major rows.
-    let t = DMat4::from_cols_array_2d(&m).transpose();
+    Ok(DMat4::from_cols_array_2d(&m).transpose())
+}
+
+fn checked_matrix(
+    ctx: &Ctx,
+    field: &str,
+    m: [[f64; 4]; 4],
+    warnings: &mut Vec<String>,
+) -> Result<DMat4> {
+    let t = affine_matrix(ctx, field, m)?;
     let lin = DMat3::from_mat4(t);
     let cols = [lin.x_axis, lin.y_axis, lin.z_axis];
     let size = cols.iter().map(|c| c.length()).fold(0.0, f64::max);

@@ -49,7 +49,7 @@ use super::spectrum::{EmissionSpectrum, SpectrumSpec, VISIBLE_NM};
 use crate::color::Spectrum;
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::optics::medium::air;
-use crate::scene::geometry_file::{Units, rotation_deg};
+use crate::scene::geometry_file::{Units, affine_matrix, rotation_deg};
 use crate::spec_check::Ctx;
 use anyhow::{Result, bail};
 use glam::{DMat3, DVec3};
@@ -363,16 +363,8 @@ impl RayFileSpec {
             (Some(_), Some(_)) => Err(ctx.err(&f("matrix"), "give rotate_deg or matrix, not both")),
             (Some(r), None) => Ok((rotation_deg(ctx.angles_deg(&f("rotate_deg"), r)?), shift)),
             (None, Some(m)) => {
-                for (r, row) in m.iter().enumerate() {
-                    for (c, x) in row.iter().enumerate() {
-                        ctx.finite(&format!("{}[{r}][{c}]", f("matrix")), *x)?;
-                    }
-                }
-                if m[3] != [0.0, 0.0, 0.0, 1.0] {
-                    return Err(ctx.err(&f("matrix"), "the last row must be [0, 0, 0, 1]"));
-                }
-                let rot =
-                    DMat3::from_cols_array_2d(&[0, 1, 2].map(|c| [m[0][c], m[1][c], m[2][c]]));
+                let t = affine_matrix(ctx, &f("matrix"), m)?;
+                let rot = DMat3::from_mat4(t);
                 let ortho = (rot.transpose() * rot - DMat3::IDENTITY)
                     .to_cols_array()
                     .iter()
@@ -380,7 +372,7 @@ impl RayFileSpec {
                 if !ortho {
                     return Err(ctx.err(&f("matrix"), "must be a rotation (orthonormal columns): a ray file cannot be stretched or sheared"));
                 }
-                let moved = ctx.point(&f("matrix"), [m[0][3], m[1][3], m[2][3]])?;
+                let moved = ctx.point(&f("matrix"), t.w_axis.truncate().to_array())?;
                 Ok((rot, shift + moved))
             }
             (None, None) => Ok((DMat3::IDENTITY, shift)),

@@ -354,6 +354,14 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
             num(m.cv.value, 3),
             num(m.cv_noise_floor, 3)
         );
+        if m.cv_noise_floor > 0.3 {
+            // The floor falls as 1/sqrt(photons): a floor of 0.1 needs (floor/0.1)^2 times more.
+            let needed = s.photons as f64 * (m.cv_noise_floor / 0.1).powi(2);
+            say!(
+                "note       the luminance map is mostly noise at this photon count (a {}° cone holds few photons): a noise floor of 0.1 needs about {needed:.1e} photons, or widen --luminance-cone-deg",
+                m.cone_deg
+            );
+        }
     }
     for f in files {
         say!("wrote      {}", f.display());

@@ -358,6 +358,12 @@ impl Ledger {
         self.feature_hits_by_tag[tag as usize] += u64::from(feature);
     }
 
+    /// Count `n` interactions with tag `tag` outside its pattern (a run of them).
+    pub(crate) fn plain_hits(&mut self, tag: u32, n: u64) {
+        self.interactions += n;
+        self.hits_by_tag[tag as usize] += n;
+    }
+
     /// Book the weight lost between `before` and `after` at `sink`.
     pub(crate) fn lose(sink: &mut ExactSum, before: f64, after: f64) {
         // Nothing lost (every analog scattering): adding w and -w would leave the sum

@@ -20,6 +20,7 @@
 mod body_boxes;
 mod flight;
 mod solid_walk;
+mod tir_run;
 
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
@@ -475,20 +476,24 @@ fn detection(
 }
 
 /// For the tracer's tests: chunks 0 and 7 (seed 5) of the bundled scene `name`, traced
-/// by a tracer as built (BVH backend, convex path on) and by one changed by `alter`, are
-/// the same bits (ledgers and detections); returns the first tracer's chunks.
+/// by a tracer as built (BVH backend, convex path on) and changed by `base`, and by one
+/// changed by `base` then `alter`, are the same bits (ledgers and detections); returns
+/// the first tracer's chunks.
 #[cfg(test)]
 fn assert_same_chunks(
     name: &str,
     estimator: Estimator,
+    base: impl Fn(&mut Tracer),
     alter: impl FnOnce(&mut Tracer),
 ) -> Vec<ChunkTally> {
     let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
     let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
     let accel = crate::accel::build(crate::accel::BackendChoice::Bvh, scene.mesh.clone()).unwrap();
     let facets = scene.mesh.facets();
-    let built = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    let mut built = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
     let mut altered = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    base(&mut built);
+    base(&mut altered);
     alter(&mut altered);
     [0, 7]
         .map(|chunk| {

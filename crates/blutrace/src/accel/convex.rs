@@ -82,6 +82,23 @@ impl ConvexSolid {
         })
     }
 
+    /// The solid as an axis-aligned box, when it is one: its low and high corners and,
+    /// per axis, the triangle standing for its low and high faces (`None` for a face
+    /// carrying several tags) with that face's normal.
+    pub fn axis_faces(&self) -> Option<AxisFaces> {
+        let b = self.axis_box.as_ref()?;
+        let face = |i: usize| {
+            let q = &self.planes[i];
+            q.one_tag.then_some((q.prims[0], q.normal))
+        };
+        Some(AxisFaces {
+            lo: b.lo,
+            hi: b.hi,
+            lo_face: b.lo_plane.map(face),
+            hi_face: b.hi_plane.map(face),
+        })
+    }
+
     /// Number of distinct face planes.
     pub fn plane_count(&self) -> usize {
         self.planes.len()
@@ -140,6 +157,19 @@ impl ConvexSolid {
 }
 
 /// An axis-aligned box solid: its six planes by axis and side.
+/// An axis-aligned box solid's corners and faces ([`ConvexSolid::axis_faces`]).
+#[derive(Clone, Copy, Debug)]
+pub struct AxisFaces {
+    /// The low corner.
+    pub lo: DVec3,
+    /// The high corner.
+    pub hi: DVec3,
+    /// Per axis, the low face's triangle and outward normal (`None`: several tags).
+    pub lo_face: [Option<(u32, DVec3)>; 3],
+    /// Per axis, the high face's triangle and outward normal (`None`: several tags).
+    pub hi_face: [Option<(u32, DVec3)>; 3],
+}
+
 #[derive(Clone, Debug)]
 struct AxisBox {
     /// Low and high corner.

@@ -288,12 +288,54 @@ impl DotPattern {
     }
 
     /// [`DotPattern::covers`] for a pattern with a column table `radii` (from
-    /// [`DotPattern::column_radii`]): the same answer at every point.
+    /// [`DotPattern::column_radii`]): the same answer at every point (but points exactly
+    /// half-way between two cells, where the two take different cells).
+    #[inline]
     pub fn covers_tabled(&self, p: DVec3, radii: &ColumnRadii) -> bool {
+        if self.lattice == Lattice::Square {
+            return self.first_covered(p, DVec3::ZERO, 1, radii) == 0;
+        }
         let q = self.face_coords(p);
         let (i, j, c) = self.nearest_cell_centre(q);
         q.distance_squared(c) < radii.get(i, j)
     }
+
+    /// The first `j` in `0..n` whose point `start + j step` on the face meets ink, or `n`:
+    /// [`DotPattern::covers_tabled`] at each point (a run of landings along a line). On a
+    /// square lattice the face coordinates go up by the same step in cell units, and the
+    /// nearest cell centre is found by float rounding, so the points' tests do not wait on
+    /// each other or on float-integer conversions (but the table's column).
+    #[inline]
+    pub fn first_covered(&self, start: DVec3, step: DVec3, n: u32, radii: &ColumnRadii) -> u32 {
+        if self.lattice != Lattice::Square {
+            let point = |j: u32| start + step * f64::from(j);
+            return (0..n)
+                .find(|&j| self.covers_tabled(point(j), radii))
+                .unwrap_or(n);
+        }
+        let per_pitch = 1.0 / self.pitch;
+        // Cell units, measured from the centre of cell (0, 0).
+        let q0 = self.face_coords(start) * per_pitch - 0.5;
+        let dq = DVec2::new(step.dot(self.axis), step.dot(self.across)) * per_pitch;
+        let p2 = self.pitch * self.pitch;
+        for j in 0..n {
+            let q = q0 + dq * f64::from(j);
+            let centre = DVec2::new(round_to_integer(q.x), round_to_integer(q.y));
+            if (q - centre).length_squared() * p2 < radii.get(centre.x as i64, 0) {
+                return j;
+            }
+        }
+        n
+    }
+}
+
+/// `x` rounded to an integer (halves to even) for `|x| < 2^51`, in two additions: no
+/// libm call (x86-64's baseline has no rounding instruction) and no round trip through an
+/// integer.
+#[inline(always)]
+fn round_to_integer(x: f64) -> f64 {
+    const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52: its ulp is 1
+    (x + SHIFT) - SHIFT
 }
 
 /// The dots of one bucket of the stochastic screen, drawn as they are asked for.

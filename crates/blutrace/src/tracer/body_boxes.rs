@@ -71,14 +71,19 @@ mod tests {
             max: DVec3::INFINITY,
         };
         for name in ["notebook14", "phone-led", "direct-lit"] {
-            let chunks = assert_same_chunks(name, Estimator::Analog, |open| {
-                let boxes = &mut open.bodies.per_medium;
-                assert!(
-                    boxes.iter().any(|m| !m.is_empty()),
-                    "{name}: no lamp bodies"
-                );
-                boxes.iter_mut().flatten().for_each(|b| b.1 = everywhere);
-            });
+            let chunks = assert_same_chunks(
+                name,
+                Estimator::Analog,
+                |_| {},
+                |open| {
+                    let boxes = &mut open.bodies.per_medium;
+                    assert!(
+                        boxes.iter().any(|m| !m.is_empty()),
+                        "{name}: no lamp bodies"
+                    );
+                    boxes.iter_mut().flatten().for_each(|b| b.1 = everywhere);
+                },
+            );
             for c in &chunks {
                 let lamps: i128 = c.ledger.absorbed_by_source.iter().map(|s| s.0).sum();
                 assert!(lamps > 0, "{name}: no photon met a lamp body");

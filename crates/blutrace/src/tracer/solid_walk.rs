@@ -184,8 +184,8 @@ impl Tracer<'_> {
     }
 
     /// The periods of total reflection `p` (on `ray`, in a medium absorbing `absorption`
-    /// per mm) can take at once ([`TirRun::skip`]), booked as the walk would: two events
-    /// and two plain hits each, the path's optical depth spent.
+    /// per mm) can take at once ([`TirRun::skip`]), booked as the walk would: an event
+    /// and a plain hit per reflection, the path's optical depth spent.
     #[inline]
     fn take_run(
         &self,
@@ -206,8 +206,8 @@ impl Tracer<'_> {
         let Some(s) = run.skip(ray, p.light, reach, left) else {
             return;
         };
-        *events += 2 * s.periods;
-        out.ledger.plain_hits(run.plain_tag, s.periods.into());
+        *events += s.events();
+        out.ledger.plain_hits(run.plain_tag, s.plain_hits().into());
         out.ledger.plain_hits(run.dotted_tag, s.periods.into());
         if absorption != 0.0 {
             p.absorption_depth -= absorption * s.length;

@@ -23,7 +23,7 @@
 
 use super::body_boxes::BodyBoxes;
 use super::tir_run::TirRun;
-use super::{Photon, Tracer, absorb_clear, convex_solid, roulette};
+use super::{Photon, ROULETTE_BELOW, Tracer, absorb_clear, convex_solid, roulette};
 use crate::accel::convex::ConvexSolid;
 use crate::estimator::Estimator;
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
@@ -136,10 +136,9 @@ impl Tracer<'_> {
         let (medium, absorption) = (p.medium, scene.media[p.medium as usize].absorption(p.light));
         let mut ray = p.ray.true_ray();
         let run = self.walks.runs[medium as usize].as_ref();
-        let run = run.filter(|_| self.estimator == Estimator::Analog);
         while *events < scene.max_bounces {
             if let Some(run) = run {
-                self.take_run(run, p, &mut ray, absorption, out, events);
+                self.take_run(run, p, &mut ray, (medium, absorption), out, events);
             }
             *events += 1;
             let exit = solid.exit(&scene.mesh, &ray);
@@ -183,24 +182,27 @@ impl Tracer<'_> {
         None
     }
 
-    /// The periods of total reflection `p` (on `ray`, in a medium absorbing `absorption`
-    /// per mm) can take at once ([`TirRun::skip`]), booked as the walk would: an event
-    /// and a plain hit per reflection, the path's optical depth spent.
+    /// The periods of total reflection `p` (on `ray`, in medium `medium` absorbing
+    /// `absorption` per mm) can take at once ([`TirRun::skip`]), booked as the walk
+    /// would: an event and a plain hit per reflection, the path's absorption spent
+    /// (analog: its optical depth; weighted: its weight, the loss booked to the medium).
     #[inline]
     fn take_run(
         &self,
         run: &TirRun,
         p: &mut Photon,
         ray: &mut Ray,
-        absorption: f64,
+        (medium, absorption): (MediumId, f64),
         out: &mut ChunkTally,
         events: &mut u32,
     ) {
-        let reach = match absorption {
-            0.0 => f64::INFINITY,
+        let reach = match (self.estimator, absorption) {
+            (_, 0.0) => f64::INFINITY,
             // The depth is drawn on the first absorbing step: none yet, no run.
-            a if p.absorption_depth < 0.0 => -a,
-            a => p.absorption_depth / a,
+            (Estimator::Analog, a) if p.absorption_depth < 0.0 => -a,
+            (Estimator::Analog, a) => p.absorption_depth / a,
+            // Weighted: the path before the weight falls to the roulette's threshold.
+            (Estimator::Weighted, a) => (p.weight / ROULETTE_BELOW).ln() / a,
         };
         let left = self.scene.max_bounces - *events;
         let Some(s) = run.skip(ray, p.light, reach, left) else {
@@ -210,7 +212,15 @@ impl Tracer<'_> {
         out.ledger.plain_hits(run.plain_tag, s.plain_hits().into());
         out.ledger.plain_hits(run.dotted_tag, s.periods.into());
         if absorption != 0.0 {
-            p.absorption_depth -= absorption * s.length;
+            match self.estimator {
+                Estimator::Analog => p.absorption_depth -= absorption * s.length,
+                Estimator::Weighted => {
+                    // One booking for the run: the walk's per-step bookings telescope to
+                    // the same first and last weight.
+                    let sink = &mut out.ledger.absorbed_in_medium[medium as usize];
+                    p.reweigh((-absorption * s.length).exp(), sink);
+                }
+            }
         }
     }
 

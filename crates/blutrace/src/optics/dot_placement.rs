@@ -300,7 +300,7 @@ impl DotPattern {
     /// face coordinates go up by the same step in cell units, and the nearest cell centre
     /// is found by float rounding, so the points' tests do not wait on each other or on
     /// float-integer conversions (but the table's index): 1.10x on bench-box against
-    /// [`DotPattern::nearest_cell_centre`]'s `floor`.
+    /// `nearest_cell_centre`'s `floor`.
     #[inline]
     pub fn first_covered(&self, start: DVec3, step: DVec3, n: u32, radii: &ColumnRadii) -> u32 {
         let (p, rows) = (self.pitch, self.row_spacing());
@@ -328,7 +328,7 @@ fn square_covered(q: DVec2, p2: f64, radii: &ColumnRadii) -> bool {
 /// Whether the point `q` (in pitches `p` along the axis and rows `rows` across, from the
 /// centre of cell (0, 0)) of a hex lattice lies in the dot of its nearest cell: the
 /// nearer of the centres of the two rows around it, the lower on a tie (as
-/// [`DotPattern::nearest_cell_centre`]).
+/// `nearest_cell_centre`).
 #[inline(always)]
 fn hex_covered(q: DVec2, p: f64, rows: f64, radii: &ColumnRadii) -> bool {
     let candidate = |j: f64| {

@@ -12,7 +12,9 @@
 //! [`SurfaceModel::interact_on`].
 //!
 //! The same physics and the same random numbers, in the same order, as the general
-//! loop: traced chunks are identical bit for bit with the walk on and off (tested).
+//! loop: traced chunks are identical bit for bit with the walk on and off (tested, with
+//! runs off). In a box guide, runs of total reflection ([`super::tir_run`]) take many
+//! steps at once, rounding positions differently.
 //! Measured (single-thread CPU time, interleaved runs): 21 % more photons/s on
 //! bench-box, 4 % on notebook14 (its photons spend more of their events in the lamp
 //! cavities). Where values live matters more here than the arithmetic: a direction

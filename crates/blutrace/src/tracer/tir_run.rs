@@ -10,6 +10,9 @@
 //! optical depth it has left runs out or the bounce cap nears. Each of those landings
 //! asks only "in a dot?", and the questions do not depend on each other, so they are
 //! asked back to back here instead of one per link of the walk's chain of positions.
+//! Measured (single-thread CPU time, interleaved rounds, the same flux maps): bench-box
+//! 1.11x with the walk's ink test, 1.20x with `DotPattern::first_covered`'s; about half of
+//! its photons' events are taken in runs.
 //!
 //! The run takes only the periods whose every step the walk would take without a random
 //! number: both reflections total, the landing out of the ink, the absorption not
@@ -136,10 +139,10 @@ impl<'a> TirRun<'a> {
     /// Move `ray` (a photon of light `light` inside the guide) over the whole periods it
     /// can take without a random number, to its last landing on the dotted face, leaving
     /// its direction as it is; or, when a landing within them is in a dot, to the plain
-    /// face before that landing, reflected towards it. `reach`: the path length the photon may travel before its
-    /// absorption depth is spent (or its weight falls to the roulette's threshold);
-    /// `events_left`: events before the bounce cap. `None`
-    /// when no period is taken (the ray is unchanged).
+    /// face before that landing, reflected towards it. `reach`: the path length the
+    /// photon may travel before its absorption depth is spent (or its weight falls to the
+    /// roulette's threshold); `events_left`: events before the bounce cap. `None` when no
+    /// period is taken (the ray is unchanged).
     #[inline]
     pub(super) fn skip(
         &self,

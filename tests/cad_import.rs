@@ -495,11 +495,7 @@ fn placement_mistakes_are_warned() {
     // A part in metres read as millimetres: 0.125 mm across is fine, 0.004 mm is not.
     let tiny: Vec<[[f64; 3]; 3]> = tris.iter().map(|t| t.map(|p| p.map(|c| c / 1e5))).collect();
     let s = load_one("cad-tiny", "part.obj", obj(&tiny).as_bytes(), "");
-    assert!(
-        s.warnings.iter().any(|w| w.contains("check units")),
-        "{:?}",
-        s.warnings
-    );
+    assert_warns(&s, "check units");
     // The same part 1000 x too large (mm read as metres), moved clear of the LED (which
     // it would otherwise swallow: an error, tested below).
     let s = load_one(
@@ -508,11 +504,7 @@ fn placement_mistakes_are_warned() {
         obj(&tris).as_bytes(),
         "units = \"m\"\ntranslate = [0.0, 0.0, 1000000.0]",
     );
-    assert!(
-        s.warnings.iter().any(|w| w.contains("check units")),
-        "{:?}",
-        s.warnings
-    );
+    assert_warns(&s, "check units");
     // Lifted by 2 mm, the part is cut by the detector plane (z = 4.5).
     let s = load_one(
         "cad-cut",
@@ -520,13 +512,7 @@ fn placement_mistakes_are_warned() {
         obj(&tris).as_bytes(),
         "translate = [0.0, 0.0, 2.0]",
     );
-    assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.contains("detector plane cuts tag 'lgp'")),
-        "{:?}",
-        s.warnings
-    );
+    assert_warns(&s, "detector plane cuts tag 'lgp'");
     // Moved 1 mm towards the LED and lifted 1 mm, the PMMA part's bottom face crosses
     // the LED's emitting rectangle: the lamp lies half in the PMMA, half in air.
     let dir = write_scene(
@@ -646,12 +632,9 @@ fn gltf_primitives_without_materials_take_their_mesh_or_node_name() {
     let by_mesh = no_material.replace(r#""meshes":[{"#, r#""meshes":[{"name":"lgp","#);
     let s = load(&scene_dir("gltf-mesh-name", &by_mesh));
     assert_eq!(s.tags, ["lgp"]);
-    assert!(
-        s.warnings.iter().any(|w| w.contains(
-            "nodes[0] meshes[0] 'lgp' primitives[0]: no material name, tagged 'lgp' by its mesh's name"
-        )),
-        "{:?}",
-        s.warnings
+    assert_warns(
+        &s,
+        "nodes[0] meshes[0] 'lgp' primitives[0]: no material name, tagged 'lgp' by its mesh's name",
     );
     let by_node = no_material.replace(
         r#""nodes":[{"mesh":0}]"#,
@@ -659,11 +642,7 @@ fn gltf_primitives_without_materials_take_their_mesh_or_node_name() {
     );
     let s = load(&scene_dir("gltf-node-name", &by_node));
     assert_eq!(s.tags, ["lgp"]);
-    assert!(
-        s.warnings.iter().any(|w| w.contains("by its node's name")),
-        "{:?}",
-        s.warnings
-    );
+    assert_warns(&s, "by its node's name");
     let err = format!(
         "{:#}",
         Scene::load(&scene_dir("gltf-no-name", &no_material)).expect_err("an untagged primitive")

@@ -15,7 +15,7 @@ use blutrace::sources::Emitter;
 use blutrace::sources::rayfile::{FileSpectrum, FluxUnit, RaySet, StoredRay, check_ray, tm25};
 use glam::DVec3;
 use std::path::Path;
-use support::{assert_balanced, check_output, load, temp_folder, trace, write_scene};
+use support::{assert_balanced, assert_warns, check_output, load, temp_folder, trace, write_scene};
 
 /// The bundled phone-led scene with cos^3 LEDs (no intensity table) copied into `dir`.
 fn cos_led_scene(dir: &Path) -> String {
@@ -396,12 +396,8 @@ fn a_ray_file_with_wavelengths_makes_the_media_spectral() {
         "{:?}",
         milk.scattering
     );
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("media.milk.particles.wavelength_nm = 480 is not used")),
-        "{:?}",
-        scene.warnings
+    assert_warns(
+        &scene,
+        "media.milk.particles.wavelength_nm = 480 is not used",
     );
 }

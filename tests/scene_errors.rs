@@ -173,14 +173,7 @@ fn inverted_faces_are_rewound_with_a_warning() {
         })
         .collect();
     let scene = load(&write_scene("inverted", GOOD, &[("plate.obj", &obj)]));
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("re-wound 12 of 12")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_warns(&scene, "re-wound 12 of 12");
     // Outward: the front face (+z) normal points up.
     let front = (0..scene.mesh.len() as u32)
         .find(|&p| scene.mesh.corners(p).iter().all(|c| c.z > 0.0))

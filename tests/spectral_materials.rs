@@ -296,13 +296,9 @@ fn monochrome_particles_stay_one_evaluation_at_their_wavelength() {
     let dir = slab("spectral-mie", &medium, &narrow_band(480.0));
     let scene = load(&dir);
     assert!(medium_named(&scene, "slab").scattering.per_mm.is_spectral());
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("media.slab.particles.wavelength_nm = 480 is not used")),
-        "{:?}",
-        scene.warnings
+    assert_warns(
+        &scene,
+        "media.slab.particles.wavelength_nm = 480 is not used",
     );
 }
 

@@ -187,6 +187,16 @@ pub fn assert_balanced(r: &RunResult) {
     assert_eq!(groups, l.photons, "group tallies do not add up to the run");
 }
 
+/// Assert that one of `scene`'s warnings contains `needle` (listing them if none does).
+#[track_caller]
+pub fn assert_warns(scene: &Scene, needle: &str) {
+    assert!(
+        scene.warnings.iter().any(|w| w.contains(needle)),
+        "no warning contains {needle:?}: {:?}",
+        scene.warnings
+    );
+}
+
 /// Fraction `k / n` and whether it is within `z` standard errors of `p`.
 pub fn within_sigma(k: f64, n: f64, p: f64, z: f64) -> (f64, f64, bool) {
     let frac = k / n;

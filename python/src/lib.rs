@@ -2,12 +2,12 @@
 //! Python package `blutrace` (`python/blutrace/`) re-exports everything here; its
 //! docstrings and type stubs (`__init__.pyi`) are the user's reference.
 //!
-//! - [`scene`]: `Scene` (load, key paths, check, trace, optimize);
-//! - [`run`]: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
-//! - [`optimization`]: `Optimization`, the outcome of `Scene.optimize`;
-//! - [`detached`]: long work on a thread of its own, with the GIL released, Ctrl-C
+//! - `scene`: `Scene` (load, key paths, check, trace, optimize);
+//! - `run`: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
+//! - `optimization`: `Optimization`, the outcome of `Scene.optimize`;
+//! - `detached`: long work on a thread of its own, with the GIL released, Ctrl-C
 //!   honoured and panics turned into exceptions;
-//! - [`convert`]: TOML and JSON values to and from Python objects, and argument checks.
+//! - `convert`: TOML and JSON values to and from Python objects, and argument checks.
 
 mod convert;
 mod detached;

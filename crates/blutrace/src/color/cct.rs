@@ -38,7 +38,7 @@ pub fn planckian_uv(kelvin: f64) -> [f64; 2] {
 /// outside 1000-100000 K.
 ///
 /// Ohno's (2014) cascade: the nearest entry of a table of the locus at 1 % steps brackets the
-/// answer between its neighbours; that bracket is divided into [`CASCADE_POINTS`] steps, and
+/// answer between its neighbours; that bracket is divided into `CASCADE_POINTS` steps, and
 /// the nearest point's neighbours are the next bracket, until it is narrower than 0.001 K.
 /// Every point of the locus is computed from Planck's law and the CMFs, so the CCT is the
 /// minimum-distance one of the definition, to the precision of the tables.

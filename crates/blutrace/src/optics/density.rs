@@ -498,14 +498,14 @@ impl Gradation {
     }
 
     /// The first position (mm) along the span where the value is not finite or outside
-    /// `[lo, hi]`, with that value (see [`Gradation::span_values`]).
+    /// `[lo, hi]`, with that value (at 4097 evenly spaced positions).
     pub fn first_outside(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
         self.span_values(4096)
             .find(|&(_, v)| !v.is_finite() || !(lo..=hi).contains(&v))
     }
 
     /// How far the value leaves `[lo, hi]` anywhere on the span (0: within; infinite
-    /// where it is not finite), from `samples + 1` values (see [`Gradation::span_values`]).
+    /// where it is not finite), from `samples + 1` evenly spaced values.
     pub fn worst_excess(&self, lo: f64, hi: f64, samples: usize) -> f64 {
         self.span_values(samples)
             .map(|(_, v)| {

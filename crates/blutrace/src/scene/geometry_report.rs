@@ -137,7 +137,7 @@ const SAME_SIZE: f64 = 1.3;
 /// unit factor, takes the footprint of the rest of the scene (the other parts' bounding
 /// box) or of the detector (`detector_mm`, its two sides): about 25.4x or 1000x off, as a
 /// file exported in other units than read is. Both of the two largest sides must match
-/// within [`SAME_SIZE`], which a small part that is only proportioned like the scene (an
+/// within `SAME_SIZE`, which a small part that is only proportioned like the scene (an
 /// LED package, a screw) does not.
 pub fn unit_slip_warnings(
     reports: &[GeometryReport],

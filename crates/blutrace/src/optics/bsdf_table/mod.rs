@@ -1,5 +1,5 @@
 //! Measured BSDF tables: a face that scatters as an IS BSDF file (Zemax/Radiant BSDF Data
-//! Interchange format, [`format`]) says, as scatterometers measure films, sheets and inks
+//! Interchange format, [`mod@format`]) says, as scatterometers measure films, sheets and inks
 //! and `blutrace bsdf` characterises a part of a scene.
 //!
 //! ```toml

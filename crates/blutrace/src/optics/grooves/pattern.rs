@@ -63,7 +63,7 @@ struct Crossing {
 
 impl GroovePattern {
     /// A pattern with its derived depth; angles in radians. The caller has checked the
-    /// parameters (see [`super::GroovesSpec::build`]).
+    /// parameters (`GroovesSpec::build`, in `spec.rs`).
     pub fn new(
         relief: Relief,
         pitch: f64,

@@ -10,7 +10,7 @@
 //! `delta_uv_max` the largest between any two spots (the display-lab colour
 //! non-uniformity). Being the largest of 13 noisy distances, `delta_uv_13pt` is biased up
 //! by the noise; `delta_uv_13pt_noise_floor` is what noise alone would give, and
-//! `delta_uv_13pt_debiased` removes it in quadrature ([`debiased`]), as `cv_debiased` does
+//! `delta_uv_13pt_debiased` removes it in quadrature (`debiased`), as `cv_debiased` does
 //! for the cv. Errors: delete-one-group jackknife over the run's photon groups, as
 //! for every non-linear metric ([`super::jackknife`]).
 
@@ -296,7 +296,7 @@ fn with_leave_out(
     Some((own, leave_out))
 }
 
-/// Δu'v' 13-point debiased by the spots' noise ([`debiased_delta`]) of `total`, and its
+/// Δu'v' 13-point of `total` debiased by the spots' noise (`debiased`), and its
 /// leave-one-out values over `groups` (in the order of [`super::Estimates::leave_out`], so
 /// a function of it and the flux metrics gets its jackknife error); `None` for a
 /// monochrome run.

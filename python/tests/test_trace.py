@@ -152,6 +152,22 @@ def test_progress_true_reports_on_stderr_without_tqdm(box, capsys, monkeypatch):
     assert f"{N}/{N} photons" in capsys.readouterr().err
 
 
+def test_progress_true_draws_a_tqdm_bar_of_the_photons(box, monkeypatch):
+    import tqdm.auto
+
+    bars = []
+
+    class Watched(tqdm.auto.tqdm):
+        def close(self):  # tqdm closes again when collected: count the first
+            if not self.disable:
+                bars.append((self.n, self.total, self.unit))
+            super().close()
+
+    monkeypatch.setattr(tqdm.auto, "tqdm", Watched)
+    box.trace(photons=N, seed=1, progress=True)
+    assert bars == [(N, N, "photons")]
+
+
 def test_a_bad_progress_is_a_type_error(box):
     with pytest.raises(TypeError, match="progress"):
         box.trace(photons=1000, progress="yes")

@@ -1,6 +1,8 @@
 //! Shared helpers for integration tests: tiny scenes written to temporary folders.
 #![allow(dead_code)]
 
+pub mod bsdf;
+
 use blutrace::accel::BackendChoice;
 use blutrace::optics::dots::{Density, DotPattern, Gradation, Lattice, Placement, XUnit};
 use blutrace::run::{self, RunOptions, RunResult};

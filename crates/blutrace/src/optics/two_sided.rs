@@ -15,7 +15,8 @@
 //! solids' orientation leaves it alone); `blutrace check` counts each tag's triangles by the axis their normal
 //! points along, so which side is the front can be read off. Without `back` both sides
 //! carry the same model. A dielectric-like face (dielectric, dots, grooves, diffuser) has
-//! no back: its two sides are its two media.
+//! no back: its two sides are its two media. A `bsdf_table` gives its back as measured
+//! tables (`back_file`) instead, with or without light through it.
 
 use super::medium::Medium;
 use super::opaque::OpaqueSpec;
@@ -72,6 +73,14 @@ impl SurfaceEntry {
                     "'{}' lets light through: its two sides are its media, it has no back (back is for lambert, phong, mirror or absorber)",
                     front.kind()
                 ),
+            ));
+        }
+        if let SurfaceModel::BsdfTable(t) = &front
+            && t.back.is_some()
+        {
+            return Err(ctx.err(
+                &format!("{at}.back"),
+                "and back_file both say how the back scatters: give one of them",
             ));
         }
         let back = back.build(ctx, &format!("{at}.back"), media, "a surface's back")?;

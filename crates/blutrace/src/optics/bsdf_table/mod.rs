@@ -6,6 +6,7 @@
 //! [surfaces.diffuser_film]
 //! model = "bsdf_table"
 //! file = "film.bsdf"       # or a list: file = ["film_r.bsdf", "film_t.bsdf"]
+//! back_file = "film_back.bsdf" # optional: measured with light arriving on the back
 //! inside = "air"           # with a BTDF: the medium behind the face (as dielectric's)
 //! outside = "air"          # default "air"
 //! u_axis = [1.0, 0.0, 0.0] # optional: the direction of sample rotation 0 on the face
@@ -13,8 +14,8 @@
 //! ```
 //!
 //! The files hold at most one BRDF and one BTDF section. A photon arriving at the
-//! angle of incidence `theta` (to the face's normal on its side, either side: the part is
-//! taken as the same seen from both) is reflected back into its medium with probability
+//! angle of incidence `theta` (to the face's normal on its side) is reflected back into
+//! its medium with probability
 //! `TIS_R(theta)`, transmitted into the medium on the other side with probability
 //! `TIS_T(theta)` (a table with a BTDF is an interface and needs `inside`), else absorbed
 //! (analog roulette, or the weight `TIS_R + TIS_T` when absorption is weighted). The
@@ -38,9 +39,17 @@
 //! so a film's colour (a yellowish sheet's lower Z) is not traced; trace the channels in
 //! turn to see how much it matters.
 //!
+//! The two sides: `file` holds the tables measured with light arriving on the front (the
+//! side the triangles' normals point to, `outside`), `back_file` those measured with light
+//! arriving on the back (`inside`), as a scatterometer measures a film turned over about
+//! `u_axis`: sample rotations on the back are read from `u_axis` the same way, seen from
+//! the back. Without `back_file` the part is taken as the same seen from both sides, which
+//! a prism film or a film coated on one side is not. The two sides' tables are checked
+//! each on its own (TIS sums at most 1); nothing ties them together (reciprocity between a
+//! front BTDF and a back BTDF is the measurement's business).
+//!
 //! What a table leaves out: where the light leaves (a part's lateral spread: light
-//! enters and leaves at one point), polarisation, coherence, and any difference between
-//! the part's two sides.
+//! enters and leaves at one point), polarisation and coherence.
 
 pub mod format;
 pub mod sample;
@@ -81,8 +90,11 @@ impl Files {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BsdfTableSpec {
-    /// The IS BSDF file(s), relative to the scene file.
+    /// The IS BSDF file(s), relative to the scene file: light arriving on the front.
     pub file: Files,
+    /// The file(s) measured with light arriving on the back (`None`: as the front).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub back_file: Option<Files>,
     /// Medium behind the face (needed with a BTDF).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inside: Option<String>,
@@ -193,13 +205,31 @@ impl Table {
     }
 }
 
-/// A face that scatters as measured tables say.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BsdfTable {
+/// The tables of light arriving on one side of a face.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Side {
     /// The reflection table.
     pub brdf: Option<Arc<Table>>,
     /// The transmission table.
     pub btdf: Option<Arc<Table>>,
+}
+
+impl Side {
+    /// The TIS of reflection and transmission for a photon of `inc`.
+    fn tis(&self, inc: &Incidence) -> (f64, f64) {
+        let of =
+            |t: &Option<Arc<Table>>| t.as_ref().map_or(0.0, |t| t.tis(inc.rotation, inc.theta));
+        (of(&self.brdf), of(&self.btdf))
+    }
+}
+
+/// A face that scatters as measured tables say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BsdfTable {
+    /// Light arriving on the front (the side the normals point to).
+    pub front: Side,
+    /// Light arriving on the back (`None`: as on the front).
+    pub back: Option<Side>,
     /// The two media (with a BTDF; `None`: opaque).
     pub interface: Option<Interface>,
     /// The direction of sample rotation 0 (`None`: world x, or y on faces facing x).
@@ -214,30 +244,25 @@ impl BsdfTable {
             .unwrap_or(if n.x.abs() > 0.9 { DVec3::Y } else { DVec3::X });
         (u - u.dot(n) * n).normalize()
     }
-
-    /// The TIS of reflection and transmission for a photon of `inc`.
-    fn tis(&self, inc: &Incidence) -> (f64, f64) {
-        let of =
-            |t: &Option<Arc<Table>>| t.as_ref().map_or(0.0, |t| t.tis(inc.rotation, inc.theta));
-        (of(&self.brdf), of(&self.btdf))
-    }
 }
 
 impl Surface for BsdfTable {
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let n = at.facing();
         let inc = sample::incidence(at.dir, n, self.u_on(n));
-        let (r, t) = self.tis(&inc);
+        let on_front = at.dir.dot(at.hit.normal) < 0.0;
+        let side = match &self.back {
+            Some(back) if !on_front => back,
+            _ => &self.front,
+        };
+        let (r, t) = side.tis(&inc);
         let Some(weight) = at.est.survive(r + t, rng) else {
             return (Outcome::Absorbed, Feature::Plain);
         };
         let reflect = rng.uniform() * (r + t) < r;
         let (table, medium) = match (reflect, self.interface) {
-            (true, _) => (&self.brdf, at.medium),
-            (false, Some(i)) => {
-                let entering = at.dir.dot(at.hit.normal) < 0.0;
-                (&self.btdf, if entering { i.inside } else { i.outside })
-            }
+            (true, _) => (&side.brdf, at.medium),
+            (false, Some(i)) => (&side.btdf, if on_front { i.inside } else { i.outside }),
             (false, None) => return (Outcome::Absorbed, Feature::Plain),
         };
         let dir = table.as_ref().and_then(|tab| tab.sample(&inc, rng));
@@ -274,17 +299,20 @@ impl SurfaceSpecOf for BsdfTableSpec {
     type Model = BsdfTable;
 
     fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<BsdfTable> {
-        let dir = ctx.0.parent().unwrap_or(Path::new("."));
-        let field = format!("{at}.file");
-        let files = self.file.list();
-        if files.is_empty() {
-            return Err(ctx.err(&field, "names no file"));
-        }
-        let (brdf, btdf) = read_tables(ctx, (&field, at), dir, &files, self.tristimulus)?;
-        check_sum(ctx, &field, brdf.as_ref(), btdf.as_ref())?;
+        let read = |key: &str, files: &Files| {
+            let field = format!("{at}.{key}");
+            read_side(ctx, (&field, at), &files.list(), self.tristimulus)
+        };
+        let (front, front_btdf) = read("file", &self.file)?;
+        let back = self
+            .back_file
+            .as_ref()
+            .map(|f| read("back_file", f))
+            .transpose()?;
+        let btdf = front_btdf.or_else(|| back.as_ref().and_then(|b| b.1.clone()));
         let interface = match (&self.inside, &btdf) {
             (Some(inside), _) => Some(Interface::build(ctx, at, inside, &self.outside, media)?),
-            (None, Some((p, _))) => {
+            (None, Some(p)) => {
                 return Err(ctx.err(
                     &format!("{at}.inside"),
                     format!(
@@ -300,20 +328,47 @@ impl SurfaceSpecOf for BsdfTableSpec {
             .map(|u| ctx.direction(&format!("{at}.u_axis"), u))
             .transpose()?;
         Ok(BsdfTable {
-            brdf: brdf.map(|b| b.1),
-            btdf: btdf.map(|b| b.1),
+            front,
+            back: back.map(|b| b.0),
             interface,
             u_axis,
         })
     }
 
     fn files(&self) -> Vec<PathBuf> {
-        self.file.list()
+        let back = self.back_file.as_ref().map(Files::list);
+        self.file
+            .list()
+            .into_iter()
+            .chain(back.into_iter().flatten())
+            .collect()
     }
 }
 
 /// A table and the file it came from.
 type Loaded = Option<(PathBuf, Arc<Table>)>;
+
+/// Read one side's `files` (relative to the scene file; `field` names them in errors, `at`
+/// the surface) and check its TIS sums: its tables, and the file of its BTDF if any.
+fn read_side(
+    ctx: &Ctx,
+    (field, at): (&str, &str),
+    files: &[PathBuf],
+    channel: Option<Channel>,
+) -> Result<(Side, Option<PathBuf>)> {
+    if files.is_empty() {
+        return Err(ctx.err(field, "names no file"));
+    }
+    let dir = ctx.0.parent().unwrap_or(Path::new("."));
+    let (brdf, btdf) = read_tables(ctx, (field, at), dir, files, channel)?;
+    check_sum(ctx, field, brdf.as_ref(), btdf.as_ref())?;
+    let btdf_file = btdf.as_ref().map(|b| b.0.clone());
+    let side = Side {
+        brdf: brdf.map(|b| b.1),
+        btdf: btdf.map(|b| b.1),
+    };
+    Ok((side, btdf_file))
+}
 
 /// Read `files` (relative to `dir`; `field` names them in errors, `at` the surface): the
 /// BRDF and the BTDF, of channel `channel` in XYZ files.

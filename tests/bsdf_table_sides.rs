@@ -1,0 +1,230 @@
+//! A `bsdf_table` face's two sides: `back_file` holds the tables measured with light
+//! arriving on the back, and light arriving there scatters as they say; without it, as
+//! the front's. Checked against the tables' own TIS (the fractions reflected and
+//! transmitted, within 4 standard errors) and the media the photons leave into; and the
+//! errors of a back that cannot be, each naming its field.
+
+mod support;
+
+use blutrace::estimator::Estimator;
+use blutrace::optics::bsdf_table::format::{self, ScatterType};
+use blutrace::optics::medium::Medium;
+use blutrace::optics::two_sided::SurfaceEntry;
+use blutrace::spec_check::Ctx;
+use std::f64::consts::PI;
+use support::bsdf::{lambert_table, model, scatter_on, section, steps};
+use support::{assert_balanced, load, temp_folder, trace, write_scene};
+
+/// A Lambertian film as one file: reflects `r`, transmits `t` (each BSDF its TIS / pi).
+fn film(r: f64, t: f64) -> String {
+    let (aoi, az, rad) = (steps(20.0, 80.0), steps(30.0, 180.0), steps(10.0, 180.0));
+    let part = |kind, tis: f64| {
+        section(
+            kind,
+            (&aoi, &az, &rad),
+            true,
+            move |_| tis,
+            move |_, _| tis / PI,
+        )
+    };
+    let sections = [part(ScatterType::Brdf, r), part(ScatterType::Btdf, t)];
+    format::write(&sections, &["Lambertian film".into()])
+}
+
+/// Photons of `n` reflected (back to their side), transmitted (to the other side, into
+/// medium `0` air above or `1` PET below), arriving at 30 degrees from `side`.
+fn fates(m: &blutrace::optics::surface::SurfaceModel, side: f64, n: u64) -> (f64, f64, Vec<u16>) {
+    let out = scatter_on(m, 30.0, side, n, Estimator::Analog);
+    let back = out.iter().filter(|(d, _, _)| d.z * side > 0.0).count();
+    let media = out
+        .iter()
+        .filter(|(d, _, _)| d.z * side < 0.0)
+        .map(|o| o.2)
+        .collect();
+    (
+        back as f64 / n as f64,
+        (out.len() - back) as f64 / n as f64,
+        media,
+    )
+}
+
+/// Within 4 standard errors of the fraction `p` over `n` photons.
+fn near(got: f64, p: f64, n: u64) -> bool {
+    (got - p).abs() < 4.0 * (p * (1.0 - p) / n as f64).sqrt()
+}
+
+#[test]
+fn each_side_scatters_as_its_own_tables() {
+    let n = 40_000;
+    let body = "model = \"bsdf_table\"\nfile = \"f.bsdf\"\ninside = \"pet\"";
+    let front = film(0.1, 0.85);
+    let both = model(
+        &format!("{body}\nback_file = \"b.bsdf\""),
+        &[("f.bsdf", &front), ("b.bsdf", &film(0.6, 0.3))],
+    )
+    .unwrap();
+    let (r, t, into) = fates(&both, 1.0, n);
+    assert!(near(r, 0.1, n) && near(t, 0.85, n), "front: {r} {t}");
+    assert!(
+        into.iter().all(|&m| m == 1),
+        "through the front into the PET"
+    );
+    let (r, t, into) = fates(&both, -1.0, n);
+    assert!(near(r, 0.6, n) && near(t, 0.3, n), "back: {r} {t}");
+    assert!(
+        into.iter().all(|&m| m == 0),
+        "through the back into the air"
+    );
+
+    // Without back_file the back is the front.
+    let one = model(body, &[("f.bsdf", &front)]).unwrap();
+    let (r, t, _) = fates(&one, -1.0, n);
+    assert!(
+        near(r, 0.1, n) && near(t, 0.85, n),
+        "back as front: {r} {t}"
+    );
+}
+
+#[test]
+fn an_opaque_sheet_may_differ_on_its_back() {
+    let n = 40_000;
+    let sheet = model(
+        "model = \"bsdf_table\"\nfile = \"w.bsdf\"\nback_file = \"k.bsdf\"",
+        &[
+            ("w.bsdf", &lambert_table(0.95)),
+            ("k.bsdf", &lambert_table(0.05)),
+        ],
+    )
+    .unwrap();
+    let (r, t, _) = fates(&sheet, 1.0, n);
+    assert!(near(r, 0.95, n) && t == 0.0, "white front: {r} {t}");
+    let (r, t, _) = fates(&sheet, -1.0, n);
+    assert!(near(r, 0.05, n) && t == 0.0, "black back: {r} {t}");
+}
+
+/// The detected fraction of a 200 x 200 mm sheet at z = 0 whose triangles face down
+/// (-z), under a Lambertian LED at z = 5 facing down (so it lights the sheet's back), a
+/// detector at z = 10: `sheet` is its `[surfaces.sheet]` body.
+fn flipped_sheet(name: &str, sheet: &str, files: &[(&str, &str)]) -> (f64, f64) {
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n{sheet}\n\
+         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
+         [detector]\norigin = [-100.0, -100.0, 10.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [200.0, 200.0]\nbins = [4, 4]\n"
+    );
+    let obj =
+        "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\nusemtl sheet\nf 1 3 2\nf 1 4 3\n";
+    let mut all = vec![("sheet.obj", obj)];
+    all.extend_from_slice(files);
+    let run = trace(&load(&write_scene(name, &toml, &all)), 200_000, 5, 2);
+    assert_balanced(&run);
+    let n = run.tally.ledger.photons as f64;
+    (run.tally.ledger.detected.sum.value() / n, n)
+}
+
+/// End to end: a sheet black on its front and white on its back, lit on its back,
+/// detects what a white Lambertian sheet does (the back's table is Lambertian).
+#[test]
+fn a_scene_lit_on_the_back_traces_the_back_tables() {
+    let files = [
+        ("k.bsdf", lambert_table(0.05)),
+        ("w.bsdf", lambert_table(0.7)),
+    ];
+    let files: Vec<(&str, &str)> = files.iter().map(|(f, t)| (*f, t.as_str())).collect();
+    let body = "model = \"bsdf_table\"\nfile = \"k.bsdf\"\nback_file = \"w.bsdf\"";
+    let (table, n) = flipped_sheet("bsdf-back-lit", body, &files);
+    let (white, _) = flipped_sheet("bsdf-back-white", "model = \"lambert\"\nalbedo = 0.7", &[]);
+    let sigma = (table * (1.0 - table) / n + white * (1.0 - white) / n).sqrt();
+    assert!(
+        white > 0.3 && (table - white).abs() < 4.0 * sigma,
+        "back tables {table} vs white {white} (sigma {sigma})"
+    );
+}
+
+/// The error of building `[surfaces.film]` from `body` with the files `files`.
+fn error(body: &str, files: &[(&str, &str)]) -> String {
+    let dir = temp_folder("bsdf-sides");
+    for (f, text) in files {
+        std::fs::write(dir.path().join(f), text).unwrap();
+    }
+    let entry: SurfaceEntry = toml::from_str(body).unwrap();
+    let media = [
+        Medium::clear("air", 1.0, 0.0),
+        Medium::clear("pet", 1.58, 0.0),
+    ];
+    let path = dir.path().join("scene.toml");
+    let e = entry
+        .build(&Ctx(&path), "surfaces.film", &media)
+        .unwrap_err();
+    format!("{e:#}")
+}
+
+#[test]
+fn a_back_that_cannot_be_is_an_error_naming_its_field() {
+    let white = lambert_table(0.9);
+    let opaque = "model = \"bsdf_table\"\nfile = \"w.bsdf\"";
+    // A BTDF in the back's tables needs the medium behind the face.
+    let e = error(
+        &format!("{opaque}\nback_file = \"f.bsdf\""),
+        &[("w.bsdf", &white), ("f.bsdf", &film(0.2, 0.7))],
+    );
+    assert!(
+        e.contains("surfaces.film.inside") && e.contains("f.bsdf"),
+        "{e}"
+    );
+    // The back given twice: as tables and as a model.
+    let e = error(
+        &format!("{opaque}\nback_file = \"k.bsdf\"\nback = \"absorber\""),
+        &[("w.bsdf", &white), ("k.bsdf", &lambert_table(0.05))],
+    );
+    assert!(
+        e.contains("surfaces.film.back") && e.contains("back_file"),
+        "{e}"
+    );
+    // No file, and a file that is not there.
+    let e = error(&format!("{opaque}\nback_file = []"), &[("w.bsdf", &white)]);
+    assert!(
+        e.contains("surfaces.film.back_file") && e.contains("no file"),
+        "{e}"
+    );
+    let e = error(
+        &format!("{opaque}\nback_file = \"gone.bsdf\""),
+        &[("w.bsdf", &white)],
+    );
+    assert!(
+        e.contains("surfaces.film.back_file") && e.contains("gone.bsdf"),
+        "{e}"
+    );
+    // Each side's TIS may add up to at most 1.
+    let e = error(
+        &format!("{opaque}\ninside = \"pet\"\nback_file = \"f.bsdf\""),
+        &[("w.bsdf", &white), ("f.bsdf", &film(0.5, 0.7))],
+    );
+    assert!(
+        e.contains("surfaces.film.back_file") && e.contains("more than 1"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_content_hash_covers_the_back() {
+    let toml = "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n\
+                model = \"bsdf_table\"\nfile = \"w.bsdf\"\nback_file = \"k.bsdf\"\n\
+                [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
+                u = [1.0, 0.0, 0.0]\nwidth_mm = 0.5\nheight_mm = 0.5\npower_w = 1.0\n\
+                [detector]\norigin = [-5.0, -5.0, 6.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+                size_mm = [10.0, 10.0]\nbins = [2, 2]\n";
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl sheet\nf 1 2 3\n";
+    let white = lambert_table(0.9);
+    let scene = |name: &str, back: f64| {
+        let k = lambert_table(back);
+        write_scene(
+            name,
+            toml,
+            &[("sheet.obj", obj), ("w.bsdf", &white), ("k.bsdf", &k)],
+        )
+    };
+    let (a, b) = (scene("bsdf-back-a", 0.05), scene("bsdf-back-b", 0.06));
+    assert_ne!(load(&a).content_hash(), load(&b).content_hash());
+}

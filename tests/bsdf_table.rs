@@ -15,7 +15,7 @@ use blutrace::optics::bsdf_table::format::{self, ScatterType};
 use blutrace::run::RunResult;
 use glam::DVec3;
 use std::f64::consts::PI;
-use support::bsdf::{lambert_table, model, scatter, section, steps};
+use support::bsdf::{UP, lambert_table, model, scatter, section, sheet_run, steps};
 use support::{assert_balanced, chi2_quantile, load, trace, write_scene};
 
 /// Chi-square of counts against expected counts (cells expecting fewer than 5 pooled).
@@ -87,34 +87,16 @@ fn a_lambertian_table_scatters_as_lambert_does() {
     assert!(w.iter().all(|(_, wt)| (*wt - albedo).abs() < 1e-12));
 }
 
-/// A 200 x 200 mm sheet at z = 0 facing +z under a Lambertian LED at z = 5, a
-/// detector at z = 10: `sheet` is its table.
-fn sheet_run(name: &str, sheet: &str, files: &[(&str, &str)]) -> RunResult {
-    let toml = format!(
-        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n{sheet}\n\
-         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
-         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
-         [detector]\norigin = [-100.0, -100.0, 10.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-         size_mm = [200.0, 200.0]\nbins = [4, 4]\nangular_bins = [3, 4]\n"
-    );
-    let obj =
-        "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
-    let mut all = vec![("sheet.obj", obj)];
-    all.extend_from_slice(files);
-    let run = trace(&load(&write_scene(name, &toml, &all)), 200_000, 5, 2);
-    assert_balanced(&run);
-    run
-}
-
 #[test]
 fn a_lambertian_table_traces_like_lambert_in_a_scene() {
     let table = lambert_table(0.7);
     let t = sheet_run(
+        UP,
         "lambert-table",
         "model = \"bsdf_table\"\nfile = \"l.bsdf\"",
         &[("l.bsdf", &table)],
     );
-    let l = sheet_run("lambert", "model = \"lambert\"\nalbedo = 0.7", &[]);
+    let l = sheet_run(UP, "lambert", "model = \"lambert\"\nalbedo = 0.7", &[]);
     let n = t.tally.ledger.photons as f64;
     let (dt, dl) = (
         t.tally.ledger.detected.sum.value() / n,
@@ -150,11 +132,13 @@ fn an_xyz_tables_channel_traces_like_its_table() {
         |r: &RunResult| r.tally.ledger.detected.sum.value() / r.tally.ledger.photons as f64;
     for (k, albedo) in [("Y", 0.7), ("X", 0.3)] {
         let t = sheet_run(
+            UP,
             &format!("xyz-{k}"),
             &format!("model = \"bsdf_table\"\nfile = \"l.bsdf\"\ntristimulus = \"{k}\""),
             &[("l.bsdf", &table)],
         );
         let l = sheet_run(
+            UP,
             &format!("xyz-lambert-{k}"),
             &format!("model = \"lambert\"\nalbedo = {albedo}"),
             &[],

@@ -12,8 +12,8 @@ use blutrace::optics::medium::Medium;
 use blutrace::optics::two_sided::SurfaceEntry;
 use blutrace::spec_check::Ctx;
 use std::f64::consts::PI;
-use support::bsdf::{lambert_table, model, scatter_on, section, steps};
-use support::{assert_balanced, load, temp_folder, trace, write_scene};
+use support::bsdf::{DOWN, lambert_table, model, scatter_on, section, sheet_run, steps};
+use support::{load, temp_folder, write_scene};
 
 /// A Lambertian film as one file: reflects `r`, transmits `t` (each BSDF its TIS / pi).
 fn film(r: f64, t: f64) -> String {
@@ -102,23 +102,10 @@ fn an_opaque_sheet_may_differ_on_its_back() {
     assert!(near(r, 0.05, n) && t == 0.0, "black back: {r} {t}");
 }
 
-/// The detected fraction of a 200 x 200 mm sheet at z = 0 whose triangles face down
-/// (-z), under a Lambertian LED at z = 5 facing down (so it lights the sheet's back), a
-/// detector at z = 10: `sheet` is its `[surfaces.sheet]` body.
+/// The detected fraction and the photons of [`sheet_run`] with the sheet facing down,
+/// its back to the LED.
 fn flipped_sheet(name: &str, sheet: &str, files: &[(&str, &str)]) -> (f64, f64) {
-    let toml = format!(
-        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n{sheet}\n\
-         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
-         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
-         [detector]\norigin = [-100.0, -100.0, 10.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-         size_mm = [200.0, 200.0]\nbins = [4, 4]\n"
-    );
-    let obj =
-        "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\nusemtl sheet\nf 1 3 2\nf 1 4 3\n";
-    let mut all = vec![("sheet.obj", obj)];
-    all.extend_from_slice(files);
-    let run = trace(&load(&write_scene(name, &toml, &all)), 200_000, 5, 2);
-    assert_balanced(&run);
+    let run = sheet_run(DOWN, name, sheet, files);
     let n = run.tally.ledger.photons as f64;
     (run.tally.ledger.detected.sum.value() / n, n)
 }
@@ -162,49 +149,44 @@ fn error(body: &str, files: &[(&str, &str)]) -> String {
 
 #[test]
 fn a_back_that_cannot_be_is_an_error_naming_its_field() {
-    let white = lambert_table(0.9);
-    let opaque = "model = \"bsdf_table\"\nfile = \"w.bsdf\"";
-    // A BTDF in the back's tables needs the medium behind the face.
-    let e = error(
-        &format!("{opaque}\nback_file = \"f.bsdf\""),
-        &[("w.bsdf", &white), ("f.bsdf", &film(0.2, 0.7))],
-    );
-    assert!(
-        e.contains("surfaces.film.inside") && e.contains("f.bsdf"),
-        "{e}"
-    );
-    // The back given twice: as tables and as a model.
-    let e = error(
-        &format!("{opaque}\nback_file = \"k.bsdf\"\nback = \"absorber\""),
-        &[("w.bsdf", &white), ("k.bsdf", &lambert_table(0.05))],
-    );
-    assert!(
-        e.contains("surfaces.film.back") && e.contains("back_file"),
-        "{e}"
-    );
-    // No file, and a file that is not there.
-    let e = error(&format!("{opaque}\nback_file = []"), &[("w.bsdf", &white)]);
-    assert!(
-        e.contains("surfaces.film.back_file") && e.contains("no file"),
-        "{e}"
-    );
-    let e = error(
-        &format!("{opaque}\nback_file = \"gone.bsdf\""),
-        &[("w.bsdf", &white)],
-    );
-    assert!(
-        e.contains("surfaces.film.back_file") && e.contains("gone.bsdf"),
-        "{e}"
-    );
-    // Each side's TIS may add up to at most 1.
-    let e = error(
-        &format!("{opaque}\ninside = \"pet\"\nback_file = \"f.bsdf\""),
-        &[("w.bsdf", &white), ("f.bsdf", &film(0.5, 0.7))],
-    );
-    assert!(
-        e.contains("surfaces.film.back_file") && e.contains("more than 1"),
-        "{e}"
-    );
+    let (white, black) = (lambert_table(0.9), lambert_table(0.05));
+    let (film_ok, film_over) = (film(0.2, 0.7), film(0.5, 0.7));
+    // (the keys after an opaque front, the back's file, what the error says)
+    let cases = [
+        // A BTDF in the back's tables needs the medium behind the face.
+        (
+            "back_file = \"f.bsdf\"",
+            &film_ok,
+            ["surfaces.film.inside", "f.bsdf"],
+        ),
+        // The back given twice: as tables and as a model.
+        (
+            "back_file = \"f.bsdf\"\nback = \"absorber\"",
+            &black,
+            ["surfaces.film.back", "back_file"],
+        ),
+        (
+            "back_file = []",
+            &black,
+            ["surfaces.film.back_file", "no file"],
+        ),
+        (
+            "back_file = \"gone.bsdf\"",
+            &black,
+            ["surfaces.film.back_file", "gone.bsdf"],
+        ),
+        // Each side's TIS may add up to at most 1.
+        (
+            "inside = \"pet\"\nback_file = \"f.bsdf\"",
+            &film_over,
+            ["surfaces.film.back_file", "more than 1"],
+        ),
+    ];
+    for (keys, back, says) in cases {
+        let body = format!("model = \"bsdf_table\"\nfile = \"w.bsdf\"\n{keys}");
+        let e = error(&body, &[("w.bsdf", &white), ("f.bsdf", back)]);
+        assert!(says.iter().all(|s| e.contains(s)), "{keys}: {e}");
+    }
 }
 
 #[test]

@@ -1,13 +1,14 @@
 //! BSDF tables for the tests of `model = "bsdf_table"`: sections built from formulas,
 //! the model built from a `[surfaces.*]` body, photons scattered at it.
 
-use super::temp_folder;
+use super::{assert_balanced, load, temp_folder, trace, write_scene};
 use blutrace::estimator::Estimator;
 use blutrace::geometry::SurfaceHit;
 use blutrace::optics::bsdf_table::format::{self, Block, ScatterType, Section};
 use blutrace::optics::medium::Medium;
 use blutrace::optics::surface::{Outcome, SurfaceModel, SurfaceSpec};
 use blutrace::rng::PhotonRng;
+use blutrace::run::RunResult;
 use blutrace::spec_check::Ctx;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -121,4 +122,29 @@ pub fn scatter_on(
             }
         })
         .collect()
+}
+
+/// A sheet's triangles facing up (+z), towards the LED of [`sheet_run`].
+pub const UP: &str = "f 1 2 3\nf 1 3 4\n";
+/// A sheet's triangles facing down (-z): the LED of [`sheet_run`] lights their back.
+pub const DOWN: &str = "f 1 3 2\nf 1 4 3\n";
+
+/// A 200 x 200 mm sheet at z = 0 with triangles `faces` ([`UP`] or [`DOWN`]) under a
+/// Lambertian LED at z = 5 facing down, a detector at z = 10: `sheet` is its
+/// `[surfaces.sheet]` body, `files` the files beside the scene; 200,000 photons.
+pub fn sheet_run(faces: &str, name: &str, sheet: &str, files: &[(&str, &str)]) -> RunResult {
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n{sheet}\n\
+         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
+         [detector]\norigin = [-100.0, -100.0, 10.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [200.0, 200.0]\nbins = [4, 4]\nangular_bins = [3, 4]\n"
+    );
+    let obj =
+        format!("v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\nusemtl sheet\n{faces}");
+    let mut all = vec![("sheet.obj", obj.as_str())];
+    all.extend_from_slice(files);
+    let run = trace(&load(&write_scene(name, &toml, &all)), 200_000, 5, 2);
+    assert_balanced(&run);
+    run
 }

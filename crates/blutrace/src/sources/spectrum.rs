@@ -33,6 +33,11 @@ use std::path::{Path, PathBuf};
 /// The wavelengths kept of a source's spectrum (nm): the CIE 1931 observer's range.
 pub const VISIBLE_NM: (f64, f64) = (360.0, 830.0);
 
+/// How far (nm) [`EmissionSpectrum::mixture`] spreads a part's step at its ends (a table
+/// that starts or ends above zero): the mixture's table gains at most half this times the
+/// step's height there (its colour and efficacy are exact regardless).
+pub const MIX_STEP_NM: f64 = 1e-6;
+
 /// `spectrum = ...` of a `[[sources]]` entry.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
@@ -225,6 +230,75 @@ impl EmissionSpectrum {
             total,
             xyz_per_w,
         })
+    }
+
+    /// The mixture of `parts` in proportion to their weights (watts, say): the spectrum of
+    /// light drawn from part k with probability `w_k / sum(w)`. Its colour and efficacy
+    /// are exact (`sum(w_k xyz_k) / sum(w)`); its table is the parts' densities added on
+    /// the union of their knots, a part's step at an end taken over [`MIX_STEP_NM`]. `None`
+    /// if no weight is positive.
+    pub fn mixture(parts: &[(f64, &EmissionSpectrum)]) -> Option<EmissionSpectrum> {
+        let parts: Vec<_> = parts.iter().filter(|(w, _)| *w > 0.0).collect();
+        let total: f64 = parts.iter().map(|(w, _)| w).sum();
+        if parts.is_empty() || !total.is_finite() {
+            return None;
+        }
+        // The mixture's ends are the outermost part's: a step there is the table's own.
+        let lo = parts
+            .iter()
+            .map(|(_, s)| s.nm[0])
+            .fold(f64::INFINITY, f64::min);
+        let hi = parts
+            .iter()
+            .map(|(_, s)| s.range_nm().1)
+            .fold(0.0, f64::max);
+        let mut knots: Vec<f64> = Vec::new();
+        for (_, s) in &parts {
+            knots.extend(&s.nm);
+            let (a, b) = s.range_nm();
+            if s.value[0] > 0.0 && a - MIX_STEP_NM > lo {
+                knots.push(a - MIX_STEP_NM);
+            }
+            if s.value[s.value.len() - 1] > 0.0 && b + MIX_STEP_NM < hi {
+                knots.push(b + MIX_STEP_NM);
+            }
+        }
+        knots.sort_by(f64::total_cmp);
+        knots.dedup();
+        let rows: Vec<[f64; 2]> = knots
+            .iter()
+            .map(|&k| [k, parts.iter().map(|(w, s)| w / total * s.density(k)).sum()])
+            .collect();
+        let mut mix = EmissionSpectrum::new(&Spectrum::from_rows(&rows).ok()?)?;
+        let xyz = parts.iter().fold(
+            Xyz {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            },
+            |a, (w, s)| {
+                let b = s.xyz_per_w.scaled(w / total);
+                Xyz {
+                    x: a.x + b.x,
+                    y: a.y + b.y,
+                    z: a.z + b.z,
+                }
+            },
+        );
+        mix.xyz_per_w = xyz;
+        Some(mix)
+    }
+
+    /// The probability density per nm at `nm` (zero outside the knots).
+    fn density(&self, nm: f64) -> f64 {
+        let n = self.nm.len();
+        if !(self.nm[0]..=self.nm[n - 1]).contains(&nm) {
+            return 0.0;
+        }
+        let i = self.nm.partition_point(|&k| k <= nm).clamp(1, n - 1);
+        let (x0, x1) = (self.nm[i - 1], self.nm[i]);
+        let t = ((nm - x0) / (x1 - x0)).clamp(0.0, 1.0);
+        (self.value[i - 1] + t * (self.value[i] - self.value[i - 1])) / self.total
     }
 
     /// The wavelength (nm) at cumulative fraction `u` in [0, 1): the inverse of the

@@ -138,3 +138,24 @@ fn bad_spectra_are_named() {
     let e = build("{ file = \"missing.csv\" }").unwrap_err();
     assert!(e.contains("cannot read"), "{e}");
 }
+
+#[test]
+fn a_mixture_weighs_its_parts_colour_and_table_by_their_weights() {
+    let part = |rows: &[[f64; 2]]| EmissionSpectrum::new(&Spectrum::from_rows(rows).unwrap());
+    let blue = part(&[[440.0, 0.0], [460.0, 1.0], [480.0, 0.0]]).unwrap();
+    // Steps up at 500 nm and down at 600 nm.
+    let yellow = part(&[[500.0, 1.0], [600.0, 1.0]]).unwrap();
+    let mix = EmissionSpectrum::mixture(&[(3.0, &blue), (1.0, &yellow), (0.0, &blue)]).unwrap();
+    let want = 0.75 * blue.efficacy_lm_per_w() + 0.25 * yellow.efficacy_lm_per_w();
+    assert!((mix.efficacy_lm_per_w() - want).abs() < 1e-12 * want);
+    assert_eq!(mix.range_nm(), (440.0, 600.0));
+    // Its table: three quarters of the power below 490 nm, the rest flat over 500-600 nm.
+    let n = 10_000;
+    let draws: Vec<f64> = (0..n)
+        .map(|k| mix.sample((k as f64 + 0.5) / n as f64))
+        .collect();
+    assert_eq!(draws.iter().filter(|&&w| w < 490.0).count(), 7500);
+    let above_550 = draws.iter().filter(|&&w| w > 550.0).count();
+    assert!((1249..=1251).contains(&above_550), "{above_550}");
+    assert!(EmissionSpectrum::mixture(&[(0.0, &blue)]).is_none());
+}

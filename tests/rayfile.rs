@@ -13,6 +13,7 @@ use blutrace::rng::PhotonRng;
 use blutrace::scene::Scene;
 use blutrace::sources::Emitter;
 use blutrace::sources::rayfile::{FileSpectrum, FluxUnit, RaySet, StoredRay, check_ray, tm25};
+use blutrace::sources::spectrum::cmf_at;
 use glam::DVec3;
 use std::path::Path;
 use support::{assert_balanced, assert_warns, check_output, load, temp_folder, trace, write_scene};
@@ -55,6 +56,7 @@ fn led_rays(scene: &Scene, n: usize) -> RaySet {
         }),
         rays,
         nm: Vec::new(),
+        table: Vec::new(),
         spectrum: FileSpectrum::None,
         unit: FluxUnit::Watt,
         header_flux: [f64::NAN; 2],
@@ -275,6 +277,7 @@ fn scene_errors_name_the_entry_the_file_and_the_byte() {
             flux: 1.0,
         }],
         nm: Vec::new(),
+        table: Vec::new(),
         spectrum: FileSpectrum::None,
         unit: FluxUnit::Watt,
         header_flux: [f64::NAN; 2],
@@ -320,6 +323,7 @@ fn check_prints_the_ray_file() {
             },
         ],
         nm: Vec::new(),
+        table: Vec::new(),
         spectrum: FileSpectrum::Table(vec![[440.0, 0.0], [450.0, 1.0], [460.0, 0.0]]),
         unit: FluxUnit::Watt,
         header_flux: [f64::NAN; 2],
@@ -347,6 +351,78 @@ fn check_prints_the_ray_file() {
     assert_eq!(r["text"][1][1], "Maker GmbH");
     set.rays.clear();
     assert!(json["sources"][0]["rayfile"].is_null());
+}
+
+/// A white LED's ray file with spectral tables per ray: a blue table and a broad yellow
+/// one, 0.6 W of rays on the blue, 0.4 W on the yellow (two rays: weighting the tables by
+/// ray count instead of flux would give 1:2).
+fn two_table_set() -> RaySet {
+    let ray = |x: f32, flux: f32| StoredRay {
+        pos: [x, 0.0, 0.0],
+        dir: [0.0, 0.0, 1.0],
+        flux,
+    };
+    RaySet {
+        text: Default::default(),
+        rays: vec![ray(-1.0, 0.1), ray(0.0, 0.6), ray(1.0, 0.3)],
+        nm: Vec::new(),
+        table: vec![1, 0, 1],
+        spectrum: FileSpectrum::Tables(vec![
+            vec![[440.0, 0.0], [455.0, 1.0], [470.0, 0.0]],
+            vec![[480.0, 0.5], [560.0, 1.0], [650.0, 0.25], [700.0, 0.0]],
+        ]),
+        unit: FluxUnit::Watt,
+        header_flux: [f64::NAN; 2],
+    }
+}
+
+/// Luminous efficacy (lm/W) of the piecewise-linear table `rows`: 683 lm/W times
+/// ∫ S ȳ / ∫ S, by the midpoint rule at 0.001 nm.
+fn efficacy(rows: &[[f64; 2]]) -> f64 {
+    let at = |x: f64| {
+        let i = rows.iter().position(|r| r[0] >= x).unwrap().max(1);
+        let (p, q) = (rows[i - 1], rows[i]);
+        p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1])
+    };
+    let (lo, hi) = (rows[0][0], rows[rows.len() - 1][0]);
+    let n = ((hi - lo) / 1e-3) as usize;
+    let h = (hi - lo) / n as f64;
+    let (mut s, mut sy) = (0.0, 0.0);
+    for k in 0..n {
+        let x = lo + (k as f64 + 0.5) * h;
+        s += at(x) * h;
+        sy += at(x) * cmf_at(x)[1] * h;
+    }
+    683.0 * sy / s
+}
+
+#[test]
+fn spectral_tables_per_ray_mix_their_colour_by_flux() {
+    let dir = temp_folder("rayfile-tables");
+    let set = two_table_set();
+    tm25::write(&dir.path().join("x.TM25RAY"), &set).unwrap();
+    std::fs::write(dir.path().join("mirror.obj"), MIRROR).unwrap();
+    let toml = scene_two_sources("", "").replace("two.rays", "x.TM25RAY");
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, toml).unwrap();
+    let scene = load(&path);
+    let s = &scene.sources.list[1];
+    assert!((s.power_w - 1.0).abs() < 1e-7, "{}", s.power_w);
+    let FileSpectrum::Tables(tables) = &set.spectrum else {
+        unreachable!()
+    };
+    let (blue, yellow) = (efficacy(&tables[0]), efficacy(&tables[1]));
+    let want = s.power_w * (0.6 * blue + 0.4 * yellow);
+    let lm = s.luminous_flux().unwrap();
+    assert!(
+        (lm - want).abs() < 1e-6 * want,
+        "{lm} lm, expected {want} (blue {blue} lm/W, yellow {yellow} lm/W)"
+    );
+    let range = s.spectrum.as_ref().unwrap().range_nm();
+    assert_eq!(range, (440.0, 700.0));
+    let text = check_output(&path, false);
+    let want = "2 spectral tables, one per ray by index, 440-700 nm";
+    assert!(text.contains(want), "want '{want}' in:\n{text}");
 }
 
 /// The files of `fuzz/seeds/<target>`: (name, path), sorted.

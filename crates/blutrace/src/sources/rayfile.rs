@@ -28,14 +28,19 @@
 //! single wavelength (1), or a text file with an `nm` column gives each photon its ray's
 //! wavelength; its colour (luminous efficacy, lumens) is the flux-weighted 1 nm histogram
 //! of the rays' wavelengths, linear between bins. A TM-25 file with one spectral table
-//! for all rays (3) draws each photon's wavelength from the table. A file without
-//! wavelengths is monochrome unless the entry gives `spectrum = ...`. Wavelengths must lie
-//! within 360-830 nm, the CIE observer's range.
+//! for all rays (3) draws each photon's wavelength from the table. A TM-25 file with
+//! several spectral tables and a spectrum index per ray (4: a white LED whose colour
+//! changes over angle) draws each photon's wavelength from its ray's table, the same way;
+//! its colour is the mixture of the tables weighted by the flux of the rays using each.
+//! A file without wavelengths is monochrome unless the entry gives `spectrum = ...`.
+//! Wavelengths must lie within 360-830 nm, the CIE observer's range (a table's part
+//! outside it is dropped).
 //!
 //! Rays are stored as f32, in the file's own frame: within a package (a few mm) an f32
 //! position resolves 0.1 nm, and the placement (rotation, translation) is applied in f64 at
 //! emission, so a lamp 500 mm from the origin loses nothing. A ray costs 28 bytes and its
-//! alias-table cell 8: 20M rays take 720 MB.
+//! alias-table cell 8: 20M rays take 720 MB; a wavelength per ray adds 4 bytes, a spectral
+//! table index per ray 2 (a u16: at most [`MAX_TABLES`] tables).
 
 mod emitter;
 pub mod text;
@@ -138,7 +143,14 @@ pub enum FileSpectrum {
     PerRay,
     /// One spectral table `[nm, relative power]` for every ray.
     Table(Vec<[f64; 2]>),
+    /// Several spectral tables; each ray's wavelength is drawn from the one
+    /// [`RaySet::table`] names.
+    Tables(Vec<Vec<[f64; 2]>>),
 }
+
+/// Most spectral tables a ray set may hold with [`FileSpectrum::Tables`]: a ray's table
+/// is stored as a u16.
+pub const MAX_TABLES: usize = u16::MAX as usize + 1;
 
 /// The unit of the rays' flux.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -158,6 +170,9 @@ pub struct RaySet {
     pub rays: Vec<StoredRay>,
     /// The rays' wavelengths (nm) when [`FileSpectrum::PerRay`], else empty.
     pub nm: Vec<f32>,
+    /// The rays' spectral tables (0-based positions in [`FileSpectrum::Tables`]) when the
+    /// set has several, else empty.
+    pub table: Vec<u16>,
     /// What the file says of wavelengths.
     pub spectrum: FileSpectrum,
     /// The flux's unit.
@@ -168,13 +183,21 @@ pub struct RaySet {
 
 impl std::fmt::Debug for RaySet {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(
-            f,
-            "RaySet({} rays, {:?}, {:?})",
-            self.rays.len(),
-            self.unit,
-            self.spectrum
-        )
+        match &self.spectrum {
+            FileSpectrum::Tables(t) => write!(
+                f,
+                "RaySet({} rays, {:?}, Tables({} tables))",
+                self.rays.len(),
+                self.unit,
+                t.len()
+            ),
+            spectrum => write!(
+                f,
+                "RaySet({} rays, {:?}, {spectrum:?})",
+                self.rays.len(),
+                self.unit
+            ),
+        }
     }
 }
 
@@ -251,6 +274,10 @@ impl RaySet {
                 Some(r.map_or((w, w), |(a, b): (f64, f64)| (a.min(w), b.max(w))))
             }),
             FileSpectrum::Table(rows) => Some((rows[0][0], rows[rows.len() - 1][0])),
+            FileSpectrum::Tables(tables) => tables.iter().fold(None, |r, rows| {
+                let (a, b) = (rows[0][0], rows[rows.len() - 1][0]);
+                Some(r.map_or((a, b), |(lo, hi): (f64, f64)| (lo.min(a), hi.max(b))))
+            }),
         }
     }
 
@@ -264,13 +291,31 @@ impl RaySet {
             })
     }
 
-    /// The file's own spectrum: its table, or the flux-weighted 1 nm histogram of its
-    /// rays' wavelengths (`None`: no wavelengths; `Err`: no power within 360-830 nm).
+    /// The file's own spectrum: its table; the mixture of its tables, each weighted by the
+    /// flux of the rays using it; or the flux-weighted 1 nm histogram of its rays'
+    /// wavelengths (`None`: no wavelengths; `Err`: no power within 360-830 nm).
     pub fn emission_spectrum(&self) -> Option<Result<EmissionSpectrum>> {
         let spectrum = match &self.spectrum {
             FileSpectrum::None => return None,
             FileSpectrum::Table(rows) => {
-                Spectrum::from_rows(rows).map_err(|e| anyhow::anyhow!("{e}"))
+                return Some(
+                    table_spectrum(rows)
+                        .map_err(|e| anyhow::anyhow!("the file's spectral table: {e}")),
+                );
+            }
+            FileSpectrum::Tables(_) => {
+                return Some(self.table_spectra().and_then(|spectra| {
+                    let mut flux = vec![0.0; spectra.len()];
+                    for (r, &t) in self.rays.iter().zip(&self.table) {
+                        if let Some(f) = flux.get_mut(t as usize) {
+                            *f += r.flux as f64;
+                        }
+                    }
+                    let parts: Vec<_> = flux.iter().copied().zip(&spectra).collect();
+                    EmissionSpectrum::mixture(&parts).ok_or_else(|| {
+                        anyhow::anyhow!("the rays of the file's spectral tables carry no flux")
+                    })
+                }));
             }
             FileSpectrum::Single(nm) => histogram(std::iter::once((*nm, 1.0))),
             FileSpectrum::PerRay => histogram(
@@ -286,6 +331,29 @@ impl RaySet {
             })
         }))
     }
+
+    /// The emission spectrum of each of the set's tables ([`FileSpectrum::Tables`]; empty
+    /// for any other), as [`FileSpectrum::Table`]'s: `Err` names a table without power
+    /// within 360-830 nm (numbered from 1, as TM-25 does).
+    pub fn table_spectra(&self) -> Result<Vec<EmissionSpectrum>> {
+        let FileSpectrum::Tables(tables) = &self.spectrum else {
+            return Ok(Vec::new());
+        };
+        tables
+            .iter()
+            .enumerate()
+            .map(|(k, rows)| {
+                table_spectrum(rows).map_err(|e| anyhow::anyhow!("spectral table {}: {e}", k + 1))
+            })
+            .collect()
+    }
+}
+
+/// A spectral table's emission spectrum: linear between rows, kept within 360-830 nm.
+pub fn table_spectrum(rows: &[[f64; 2]]) -> Result<EmissionSpectrum> {
+    let s = Spectrum::from_rows(rows).map_err(|e| anyhow::anyhow!("{e}"))?;
+    EmissionSpectrum::new(&s)
+        .ok_or_else(|| anyhow::anyhow!("the table has no power within 360-830 nm"))
 }
 
 /// A spectrum of `(nm, flux)` pairs binned at 1 nm (nearest), linear between bins.
@@ -345,13 +413,8 @@ impl RayFileSpec {
         }
         let (rot, shift) = self.placement(ctx, at)?;
         let scale = self.units.unwrap_or(Units::Mm).mm();
-        Ok(RayFileEmitter::new(
-            self.file.clone(),
-            Arc::new(set),
-            rot,
-            scale,
-            shift,
-        ))
+        RayFileEmitter::new(self.file.clone(), Arc::new(set), rot, scale, shift)
+            .map_err(|e| ctx.err(&f("file"), format!("{}: {e:#}", self.file.display())))
     }
 
     /// The rotation and translation, checked (a matrix must be rigid: a rotation,

@@ -6,6 +6,8 @@ use crate::geometry::Ray;
 use crate::rng::PhotonRng;
 use crate::sources::body_shape::{BodyShape, Rect};
 use crate::sources::led::{FlatLed, LedProfile};
+use crate::sources::spectrum::EmissionSpectrum;
+use anyhow::{Result, bail};
 use glam::{DMat3, DVec3};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -76,6 +78,8 @@ pub struct RayFileEmitter {
     /// Its rays, in the file's frame.
     pub set: Arc<RaySet>,
     alias: Arc<Alias>,
+    /// The spectra of [`FileSpectrum::Tables`], by table (else empty).
+    spectra: Arc<Vec<EmissionSpectrum>>,
     rot: DMat3,
     scale: f64,
     shift: DVec3,
@@ -85,8 +89,38 @@ pub struct RayFileEmitter {
 
 impl RayFileEmitter {
     /// Place `set` (read from `file`): `rot` turns the file's axes, `scale` makes its
-    /// lengths mm, `shift` moves it (mm).
-    pub fn new(file: PathBuf, set: Arc<RaySet>, rot: DMat3, scale: f64, shift: DVec3) -> Self {
+    /// lengths mm, `shift` moves it (mm). `Err`: a spectral table without power within
+    /// 360-830 nm, or rays whose table indices do not match the tables (what the reader
+    /// rejects).
+    pub fn new(
+        file: PathBuf,
+        set: Arc<RaySet>,
+        rot: DMat3,
+        scale: f64,
+        shift: DVec3,
+    ) -> Result<Self> {
+        let spectra = set.table_spectra()?;
+        if matches!(set.spectrum, FileSpectrum::Tables(_)) {
+            if set.table.len() != set.rays.len() {
+                bail!(
+                    "{} rays but {} spectral table indices",
+                    set.rays.len(),
+                    set.table.len()
+                );
+            }
+            if let Some((i, t)) = set
+                .table
+                .iter()
+                .enumerate()
+                .find(|(_, t)| **t as usize >= spectra.len())
+            {
+                bail!(
+                    "ray {i}: spectral table {} of {}",
+                    *t as usize + 1,
+                    spectra.len()
+                );
+            }
+        }
         let alias = Arc::new(Alias::new(set.rays.iter().map(|r| r.flux as f64)));
         let (lo, hi) = set.bounds();
         let mid = DVec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z);
@@ -97,20 +131,22 @@ impl RayFileEmitter {
             half_width: 0.5 * (hi.x - lo.x) * scale,
             half_height: 0.5 * (hi.y - lo.y) * scale,
         };
-        Self {
+        Ok(Self {
             file,
             set,
             alias,
+            spectra: Arc::new(spectra),
             rot,
             scale,
             shift,
             front,
-        }
+        })
     }
 
     /// A photon leaving the file: a ray drawn in proportion to flux (one uniform), its
     /// placed ray, the lamp's axis (the spawn offset's direction) and its wavelength, if
-    /// the file gives one per ray.
+    /// the file gives one per ray (with spectral tables per ray, one more uniform draws it
+    /// from the ray's table, as the source's spectrum draws a table's for all rays).
     pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3, Option<f64>) {
         let i = self.alias.sample(rng.uniform());
         let r = &self.set.rays[i];
@@ -119,6 +155,9 @@ impl RayFileEmitter {
         let nm = match &self.set.spectrum {
             FileSpectrum::PerRay => Some(self.set.nm[i] as f64),
             FileSpectrum::Single(nm) => Some(*nm),
+            FileSpectrum::Tables(_) => {
+                Some(self.spectra[self.set.table[i] as usize].sample(rng.uniform()))
+            }
             FileSpectrum::None | FileSpectrum::Table(_) => None,
         };
         (Ray::new(p, d), self.front.normal, nm)
@@ -210,6 +249,12 @@ impl RayFileEmitter {
             FileSpectrum::PerRay => format!("a wavelength per ray{range}"),
             FileSpectrum::Table(rows) => {
                 format!("one table of {} rows for every ray{range}", rows.len())
+            }
+            FileSpectrum::Tables(tables) => {
+                format!(
+                    "{} spectral tables, one per ray by index{range}",
+                    tables.len()
+                )
             }
         };
         RayFileSummary {

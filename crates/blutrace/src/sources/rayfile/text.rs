@@ -79,6 +79,7 @@ pub fn read_rows(mut reader: impl BufRead, shown: &str, max_rays: usize) -> Resu
         },
         rays,
         nm,
+        table: Vec::new(),
         unit: FluxUnit::Watt,
         header_flux: [f64::NAN; 2],
     })

@@ -18,22 +18,40 @@
 //! | 20 | u64 | number of rays (4.7.1.6) |
 //! | 28 | 28 | creation date and time, ASCII (4.7.1.7, ignored) |
 //! | 56 | i32 | ray start position (4.7.1.8, ignored) |
-//! | 60 | i32 | spectral data identifier 0..4 (4.7.1.9) |
+//! | 60 | i32 | spectral data identifier (4.7.1.9): 0 none, 1 one wavelength, 2 a wavelength per ray, 3 one spectral table, 4 spectral tables chosen per ray by index; all read |
 //! | 64, 68, 72 | f32 | single, minimum, maximum wavelength, nm (4.7.1.10-12) |
-//! | 76, 80, 84 | i32 | spectral tables, additional ray items, additional text bytes |
+//! | 76, 80, 84 | i32 | spectral tables (4.7.1.13: 1 for identifier 3, 1 to 65536 for 4), additional ray items, additional text bytes |
 //! | 88 | 168 | reserved |
 //! | 256 | 8 x i32 | known data flags (4.7.2): position, direction, radiant flux, wavelength, luminous flux, Stokes, tristimulus, spectrum index |
 //! | 288 | 9 x 4000 | nine UTF-32 text fields of 1000 code points, NUL-padded (4.7.3) |
-//! | 36288 | | spectral tables (4.7.4): i32 count, then (f32 nm, f32 value) pairs; the block is zero-padded to a multiple of 32 bytes |
+//! | 36288 | | spectral tables (4.7.4), numbered 1, 2, ... in file order: each an i32 count, then (f32 nm, f32 value) pairs; the block is zero-padded to a multiple of 32 bytes |
 //! | | 512 each | names of the additional ray items, UTF-32 (4.7.5) |
 //! | | | additional text, UTF-32 (4.7.6) |
-//! | | | ray records: f32 columns x y z kx ky kz, then radiant flux, wavelength, luminous flux, Stokes S1 S2 S3 and the polarisation ellipse's x y z, tristimulus X Z, spectrum index, additional items, each only when its flag is set |
+//! | | | ray records: f32 columns x y z kx ky kz, then radiant flux, wavelength, luminous flux, Stokes S1 S2 S3 and the polarisation ellipse's x y z, tristimulus X Z, spectrum index (a whole number 1..tables, as f32), additional items, each only when its flag is set |
+//!
+//! Spectral tables per ray (identifier 4), as the reference implementation reads them
+//! (TM25RaySetTools `TM25Library/TM25_impl.h`, `ReadHeader`, and `TM25.h`): the tables
+//! carry no number of their own in the file, the reader numbers them from 1 in file order
+//! (`st.idx_ = i` for `i = 1..=M`; `TSpectralTable::idx_` is commented "base 1, not 0,
+//! see 4.7.4", and its sanity check demands `idx_ >= 1`); every ray item, the spectrum
+//! index included, is a binary32 float (the ray array is `float`; LarryBoxler's
+//! IESTM25RayFiles reads every item with `ReadSingle`). So a ray's index k names the k-th
+//! table, 1-based, stored as an f32 holding a whole number. The reference does not check
+//! the index; the text of the standard (paywalled) was not seen. Identifier 4 requires the
+//! spectrum index flag (and the flag requires identifier 4), radiant flux, and at least one
+//! table, as the reference does. Here an index must be a whole number within 1..=tables
+//! (else an error naming the ray, its byte and the field), and each table, checked like
+//! identifier 3's (wavelengths positive and increasing, values finite and >= 0), must
+//! have power within 360-830 nm; tables are kept within 360-830 nm, as identifier 3's is.
 //!
 //! The ray count must fill the file exactly (a truncated file or a lying header is an
 //! error naming both lengths). Rays are read in one pass, in chunks, straight into the
 //! compact [`RaySet`]; the file is never held whole in memory.
 
-use super::{FileSpectrum, FluxUnit, RaySet, StoredRay, TEXT_FIELDS, check_ray, checked_len};
+use super::{
+    FileSpectrum, FluxUnit, MAX_TABLES, RaySet, StoredRay, TEXT_FIELDS, check_ray, checked_len,
+    table_spectrum,
+};
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::sources::spectrum::VISIBLE_NM;
 use anyhow::{Result, bail};
@@ -97,8 +115,14 @@ struct Header {
 impl Header {
     /// f32 columns per ray record.
     fn columns(&self) -> u64 {
+        self.index_column() + self.flags[7] as u64 + self.extra_items as u64
+    }
+
+    /// The spectrum index's column (when its flag is set): after the position, direction,
+    /// fluxes, wavelength, Stokes and tristimulus columns.
+    fn index_column(&self) -> u64 {
         let f = |k: usize| self.flags[k] as u64;
-        6 + f(2) + f(3) + f(4) + 6 * f(5) + 2 * f(6) + f(7) + self.extra_items as u64
+        6 + f(2) + f(3) + f(4) + 6 * f(5) + 2 * f(6)
     }
 }
 
@@ -188,12 +212,20 @@ fn check_header(path: &Path, h: &Header) -> Result<()> {
             format!("must be 0..4, got {}", h.identifier),
         ));
     }
-    if h.identifier == 4 || h.flags[7] {
-        return Err(bad(
-            path,
-            60,
-            "spectral data identifier (4.7.1.9)",
-            "per-ray spectral tables (identifier 4, spectrum index column) are not supported",
+    if h.flags[7] != (h.identifier == 4) {
+        return Err(flag(
+            7,
+            if h.flags[7] {
+                "must be 0 unless the spectral data identifier is 4 (a spectral table per ray)"
+            } else {
+                "must be 1 when the spectral data identifier is 4 (a spectral table per ray, by index)"
+            },
+        ));
+    }
+    if h.identifier == 4 && !h.flags[2] {
+        return Err(flag(
+            2,
+            "must be 1 when the spectral data identifier is 4 (TM-25-13 4.7.2.5)",
         ));
     }
     if h.identifier == 2 && !h.flags[3] {
@@ -220,20 +252,22 @@ fn check_header(path: &Path, h: &Header) -> Result<()> {
             ),
         ));
     }
-    if h.tables < 0 || (h.identifier == 3 && h.tables != 1) {
+    let (tables_ok, need) = match h.identifier {
+        3 => (h.tables == 1, "exactly 1".to_string()),
+        4 => (
+            h.tables >= 1 && h.tables as usize <= MAX_TABLES,
+            format!("1 to {MAX_TABLES}"),
+        ),
+        _ => (h.tables >= 0, "0 or more".to_string()),
+    };
+    if !tables_ok {
         return Err(bad(
             path,
             76,
             "number of spectral tables (4.7.1.13)",
             format!(
-                "got {} (identifier {} needs {})",
-                h.tables,
-                h.identifier,
-                if h.identifier == 3 {
-                    "exactly 1"
-                } else {
-                    "0 or more"
-                }
+                "got {} (identifier {} needs {need})",
+                h.tables, h.identifier
             ),
         ));
     }
@@ -331,7 +365,7 @@ pub fn read(path: &Path) -> Result<RaySet> {
             &format!("text field 4.7.3.{}", k + 1),
         )?;
     }
-    let table = read_tables(path, &mut c, &h)?;
+    let mut tables = read_tables(path, &mut c, &h)?;
     c.take(
         path,
         h.extra_items as u64 * COLUMN_NAME_BYTES,
@@ -365,14 +399,16 @@ pub fn read(path: &Path) -> Result<RaySet> {
     let spectrum = match h.identifier {
         1 => FileSpectrum::Single(h.single_nm as f64),
         2 => FileSpectrum::PerRay,
-        3 => FileSpectrum::Table(table.expect("identifier 3 has one table")),
+        3 => FileSpectrum::Table(tables.swap_remove(0)),
+        4 => FileSpectrum::Tables(tables),
         _ => FileSpectrum::None,
     };
-    let (rays, nm) = read_rays(path, &mut c, &h, matches!(spectrum, FileSpectrum::PerRay))?;
+    let (rays, nm, table) = read_rays(path, &mut c, &h)?;
     Ok(RaySet {
         text,
         rays,
         nm,
+        table,
         spectrum,
         unit: if h.flags[2] {
             FluxUnit::Watt
@@ -383,14 +419,16 @@ pub fn read(path: &Path) -> Result<RaySet> {
     })
 }
 
-/// The spectral tables block: the first table's rows (the only one identifier 3 uses).
-fn read_tables<R: Read>(
-    path: &Path,
-    c: &mut Cursor<R>,
-    h: &Header,
-) -> Result<Option<Vec<[f64; 2]>>> {
+/// The spectral tables block: the tables the identifier uses (3: the first, 4: all, each
+/// with power within 360-830 nm; else none).
+fn read_tables<R: Read>(path: &Path, c: &mut Cursor<R>, h: &Header) -> Result<Vec<Vec<[f64; 2]>>> {
     let start = c.at;
-    let mut first = None;
+    let keep = match h.identifier {
+        3 => 1,
+        4 => h.tables as usize,
+        _ => 0,
+    };
+    let mut tables = Vec::with_capacity(keep);
     for t in 0..h.tables {
         let field = format!("spectral table {} (4.7.4)", t + 1);
         let n = i32_at(&c.take(path, 4, &field)?, 0);
@@ -423,20 +461,27 @@ fn read_tables<R: Read>(
             }
             rows.push([nm, v]);
         }
-        first.get_or_insert(rows);
+        if h.identifier == 4 {
+            table_spectrum(&rows).map_err(|e| bad(path, c.at - n as u64 * 8 - 4, &field, e))?;
+        }
+        if tables.len() < keep {
+            tables.push(rows);
+        }
     }
     let pad = (32 - (c.at - start) % 32) % 32;
     c.take(path, pad, "spectral tables' padding (4.7.4)")?;
-    Ok(first)
+    Ok(tables)
 }
 
-/// The ray records, in chunks: positions, unit directions, flux and wavelengths checked.
+/// The ray records, in chunks: positions, unit directions, flux, wavelengths (identifier
+/// 2) and spectrum indices (4, stored 0-based) checked.
 fn read_rays<R: Read>(
     path: &Path,
     c: &mut Cursor<R>,
     h: &Header,
-    per_ray_nm: bool,
-) -> Result<(Vec<StoredRay>, Vec<f32>)> {
+) -> Result<(Vec<StoredRay>, Vec<f32>, Vec<u16>)> {
+    let per_ray_nm = h.identifier == 2;
+    let index_col = (h.identifier == 4).then(|| h.index_column() as usize);
     let cols = h.columns() as usize;
     let flux_col = if h.flags[2] {
         6
@@ -446,6 +491,7 @@ fn read_rays<R: Read>(
     let n = h.rays as usize;
     let mut rays = Vec::with_capacity(n);
     let mut nm = Vec::with_capacity(if per_ray_nm { n } else { 0 });
+    let mut table = Vec::with_capacity(if index_col.is_some() { n } else { 0 });
     let mut done = 0;
     while done < n {
         let k = (n - done).min(CHUNK_RAYS);
@@ -475,39 +521,66 @@ fn read_rays<R: Read>(
             if let Some(w) = wl {
                 nm.push(w);
             }
+            if let Some(col) = index_col {
+                let field = format!("ray {} spectrum index (4.7.2.8)", done + j);
+                let t = spectrum_index(v(col), h.tables as usize)
+                    .map_err(|msg| bad(path, at(col), &field, msg))?;
+                table.push(t);
+            }
         }
         done += k;
     }
-    Ok((rays, nm))
+    Ok((rays, nm, table))
+}
+
+/// A ray's spectrum index: a whole number 1..=`tables` stored as an f32 (TM-25-13 numbers
+/// the spectral tables from 1), as the 0-based table.
+fn spectrum_index(v: f32, tables: usize) -> Result<u16, String> {
+    if !(v.is_finite() && v.fract() == 0.0) {
+        return Err(format!(
+            "must be a whole number (a spectral table, numbered from 1), got {v}"
+        ));
+    }
+    if !(v >= 1.0 && v as usize <= tables) {
+        return Err(format!(
+            "must be 1 to {tables} (the file's spectral tables, numbered from 1), got {v}"
+        ));
+    }
+    Ok((v as usize - 1) as u16)
 }
 
 /// Names of the first eight columns of a ray record, for errors.
 const COLUMN_NAMES: [&str; 8] = ["x", "y", "z", "kx", "ky", "kz", "flux", "wavelength"];
 
 /// Write `set` as a TM-25-13 file: radiant (or luminous) flux per ray, a wavelength per
-/// ray, one wavelength or one spectral table, as the set holds.
+/// ray, one wavelength, one spectral table, or several with a spectrum index per ray
+/// (written from 1), as the set holds.
 pub fn write(path: &Path, set: &RaySet) -> Result<()> {
-    if set.unit == FluxUnit::Lumen && matches!(set.spectrum, FileSpectrum::PerRay) {
-        bail!(
-            "{}: a wavelength per ray needs radiant flux (TM-25-13 4.7.2.5)",
-            path.display()
-        );
-    }
+    check_writable(set).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let head = header_bytes(set).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let file = std::fs::File::create(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
     let mut w = BufWriter::with_capacity(1 << 20, file);
     w.write_all(&head)?;
-    if let FileSpectrum::Table(rows) = &set.spectrum {
-        let mut block = (rows.len() as i32).to_le_bytes().to_vec();
-        for r in rows {
-            block.extend((r[0] as f32).to_le_bytes());
-            block.extend((r[1] as f32).to_le_bytes());
+    let tables = match &set.spectrum {
+        FileSpectrum::Table(rows) => std::slice::from_ref(rows),
+        FileSpectrum::Tables(tables) => tables.as_slice(),
+        _ => &[],
+    };
+    if !tables.is_empty() {
+        let mut block = Vec::new();
+        for rows in tables {
+            block.extend((rows.len() as i32).to_le_bytes());
+            for r in rows {
+                block.extend((r[0] as f32).to_le_bytes());
+                block.extend((r[1] as f32).to_le_bytes());
+            }
         }
         block.resize(block.len().div_ceil(32) * 32, 0);
         w.write_all(&block)?;
     }
     let per_ray = matches!(set.spectrum, FileSpectrum::PerRay);
+    let indexed = matches!(set.spectrum, FileSpectrum::Tables(_));
     for (i, r) in set.rays.iter().enumerate() {
         for x in r.pos.iter().chain(&r.dir).chain([&r.flux]) {
             w.write_all(&x.to_le_bytes())?;
@@ -515,9 +588,51 @@ pub fn write(path: &Path, set: &RaySet) -> Result<()> {
         if per_ray {
             w.write_all(&set.nm[i].to_le_bytes())?;
         }
+        if indexed {
+            w.write_all(&((set.table[i] as u32 + 1) as f32).to_le_bytes())?;
+        }
     }
     w.flush()
         .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+}
+
+/// Why `set` cannot be written as it is, if it cannot.
+fn check_writable(set: &RaySet) -> Result<()> {
+    match &set.spectrum {
+        FileSpectrum::PerRay if set.unit == FluxUnit::Lumen => {
+            bail!("a wavelength per ray needs radiant flux (TM-25-13 4.7.2.5)")
+        }
+        FileSpectrum::PerRay if set.nm.len() != set.rays.len() => {
+            bail!("{} rays but {} wavelengths", set.rays.len(), set.nm.len())
+        }
+        FileSpectrum::Tables(_) if set.unit == FluxUnit::Lumen => {
+            bail!("spectral tables per ray need radiant flux (TM-25-13 4.7.2.5)")
+        }
+        FileSpectrum::Tables(tables) => {
+            if tables.is_empty() || tables.len() > MAX_TABLES {
+                bail!("{} spectral tables: 1 to {MAX_TABLES} needed", tables.len());
+            }
+            if let Some(k) = tables.iter().position(|rows| rows.is_empty()) {
+                bail!("spectral table {} has no rows", k + 1);
+            }
+            if set.table.len() != set.rays.len() {
+                bail!(
+                    "{} rays but {} spectral table indices",
+                    set.rays.len(),
+                    set.table.len()
+                );
+            }
+            if let Some(i) = set.table.iter().position(|&t| t as usize >= tables.len()) {
+                bail!(
+                    "ray {i}: spectral table {} of {}",
+                    set.table[i] as usize + 1,
+                    tables.len()
+                );
+            }
+        }
+        _ => {}
+    }
+    Ok(())
 }
 
 /// The header, flags and text fields of `set` (36288 bytes).
@@ -541,6 +656,7 @@ fn header_bytes(set: &RaySet) -> Result<Vec<u8>> {
         FileSpectrum::Single(nm) => (1, *nm as f32, 0),
         FileSpectrum::PerRay => (2, f32::NAN, 0),
         FileSpectrum::Table(_) => (3, f32::NAN, 1),
+        FileSpectrum::Tables(t) => (4, f32::NAN, t.len() as i32),
     };
     let (lo, hi) = set
         .wavelength_range()
@@ -555,7 +671,8 @@ fn header_bytes(set: &RaySet) -> Result<Vec<u8>> {
     b.resize(HEADER_BYTES, 0);
     let watt = set.unit == FluxUnit::Watt;
     let per_ray = matches!(set.spectrum, FileSpectrum::PerRay);
-    for f in [true, true, watt, per_ray, !watt, false, false, false] {
+    let indexed = matches!(set.spectrum, FileSpectrum::Tables(_));
+    for f in [true, true, watt, per_ray, !watt, false, false, indexed] {
         b.extend((f as i32).to_le_bytes());
     }
     for (k, t) in set.text.iter().enumerate() {

@@ -156,18 +156,21 @@ fn a_ray_file_of_the_led_model_traces_like_it_at_1m_photons() {
 /// A mirror below (z = -1) that reflects only beyond 550 nm, the target above (z = 1), and
 /// a ray file `rays` (text) in between.
 fn two_colour_scene(name: &str, rays: &str, extra: &str) -> Scene {
-    let mirror = "v -5 -5 -1\nv 5 -5 -1\nv 5 5 -1\nv -5 5 -1\nusemtl mirror\nf 1 2 3\nf 1 3 4\n";
-    let toml = format!(
-        "version = 1\n[[geometry]]\nfile = \"mirror.obj\"\n\
-         [surfaces.mirror]\nmodel = \"mirror\"\nreflectance = {{ table = [[360, 0.0], [549, 0.0], [551, 1.0], [830, 1.0]] }}\n\
-         [[sources]]\ntype = \"rayfile\"\nfile = \"two.rays\"\nbody = \"transparent\"\n{extra}\
-         [detector]\norigin = [-5.0, -5.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [10.0, 10.0]\nbins = [2, 2]\n"
-    );
     load(&write_scene(
         name,
-        &toml,
-        &[("mirror.obj", mirror), ("two.rays", rays)],
+        &two_colour_toml("two.rays", extra),
+        &[("mirror.obj", MIRROR), ("two.rays", rays)],
     ))
+}
+
+/// The scene of [`two_colour_scene`] with the ray file `file`.
+fn two_colour_toml(file: &str, extra: &str) -> String {
+    format!(
+        "version = 1\n[[geometry]]\nfile = \"mirror.obj\"\n\
+         [surfaces.mirror]\nmodel = \"mirror\"\nreflectance = {{ table = [[360, 0.0], [549, 0.0], [551, 1.0], [830, 1.0]] }}\n\
+         [[sources]]\ntype = \"rayfile\"\nfile = \"{file}\"\nbody = \"transparent\"\n{extra}\
+         [detector]\norigin = [-5.0, -5.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [10.0, 10.0]\nbins = [2, 2]\n"
+    )
 }
 
 #[test]
@@ -423,6 +426,47 @@ fn spectral_tables_per_ray_mix_their_colour_by_flux() {
     let text = check_output(&path, false);
     let want = "2 spectral tables, one per ray by index, 440-700 nm";
     assert!(text.contains(want), "want '{want}' in:\n{text}");
+}
+
+#[test]
+fn photons_trace_with_their_rays_tables() {
+    // Two rays down onto the mirror that reflects only beyond 550 nm, one with the red
+    // table (0.2 W, reflected to the target), one with the blue (0.4 W, absorbed), and a
+    // blue ray straight up (0.4 W): 0.6 of the power is detected. Tables swapped: 0.8;
+    // wavelengths drawn from the mixture whatever the ray: 0.4 + 0.6 x 0.2 = 0.52.
+    let ray = |kz: f32, flux: f32| StoredRay {
+        pos: [0.0; 3],
+        dir: [0.0, 0.0, kz],
+        flux,
+    };
+    let set = RaySet {
+        text: Default::default(),
+        rays: vec![ray(-1.0, 0.2), ray(-1.0, 0.4), ray(1.0, 0.4)],
+        nm: Vec::new(),
+        table: vec![1, 0, 0],
+        spectrum: FileSpectrum::Tables(vec![
+            vec![[440.0, 0.0], [460.0, 1.0], [480.0, 0.0]],
+            vec![[600.0, 1.0], [650.0, 1.0]],
+        ]),
+        unit: FluxUnit::Watt,
+        header_flux: [f64::NAN; 2],
+    };
+    let dir = write_scene(
+        "tables-trace",
+        &two_colour_toml("x.TM25RAY", ""),
+        &[("mirror.obj", MIRROR)],
+    );
+    tm25::write(&dir.parent().unwrap().join("x.TM25RAY"), &set).unwrap();
+    let scene = load(&dir);
+    let n = 40_000;
+    let r = trace(&scene, n, 5, 2);
+    assert_balanced(&r);
+    let detected = r.tally.ledger.detected.sum.value() / n as f64;
+    let se = (0.6f64 * 0.4 / n as f64).sqrt();
+    assert!(
+        (detected - 0.6).abs() < 4.0 * se,
+        "detected {detected}, expected 0.6"
+    );
 }
 
 /// The files of `fuzz/seeds/<target>`: (name, path), sorted.

@@ -15,8 +15,11 @@ use blutrace::optics::bsdf_table::format::{self, ScatterType};
 use blutrace::run::RunResult;
 use glam::DVec3;
 use std::f64::consts::PI;
-use support::bsdf::{UP, lambert_table, model, scatter, section, sheet_run, steps};
-use support::{assert_balanced, chi2_quantile, load, trace, write_scene};
+use support::bsdf::{
+    GAP, GGX_FILM, PET, UP, film_table, lambert_table, model, polar_sums, scatter, section,
+    sheet_run, stack, steps,
+};
+use support::{chi2_quantile, load, write_scene};
 
 /// Chi-square of counts against expected counts (cells expecting fewer than 5 pooled).
 fn chi_square(counts: &[f64], expected: &[f64]) -> (f64, f64) {
@@ -363,94 +366,19 @@ fn the_content_hash_covers_the_table() {
     assert_ne!(load(&a).content_hash(), load(&b).content_hash());
 }
 
-/// The stack of the GGX film test: a 0.2 mm PET film (GGX top, smooth bottom; 400 x 400
-/// mm, so its edges see almost no light) at z = 0..0.2 over an LED at z = -5 and a
-/// Lambertian reflector at z = -6, a detector at z = 1 covering the film. `film` is the bottom face's
-/// table and `top` the top face's.
-fn stack(
-    name: &str,
-    film_bottom: &str,
-    film_top: &str,
-    media: &str,
-    files: &[(&str, &str)],
-) -> RunResult {
-    let quad = |z: f64, tag: &str, up: bool| {
-        let f = if up {
-            "f 1 2 3\nf 1 3 4"
-        } else {
-            "f 1 3 2\nf 1 4 3"
-        };
-        format!(
-            "v -200 -200 {z}\nv 200 -200 {z}\nv 200 200 {z}\nv -200 200 {z}\nusemtl {tag}\n{f}\n"
-        )
-    };
-    let edge = "v -200 -200 0\nv 200 -200 0\nv 200 -200 0.2\nv -200 -200 0.2\nv 200 200 0\nv 200 200 0.2\n\
-                v -200 200 0\nv -200 200 0.2\nusemtl film_edge\nf 1 2 3\nf 1 3 4\nf 2 5 6\nf 2 6 3\n\
-                f 5 7 8\nf 5 8 6\nf 7 1 4\nf 7 4 8\n";
-    let toml = format!(
-        "version = 1\n[[geometry]]\nfile = \"bottom.obj\"\n[[geometry]]\nfile = \"top.obj\"\n\
-         [[geometry]]\nfile = \"edge.obj\"\n[[geometry]]\nfile = \"sheet.obj\"\n{media}\n\
-         [surfaces.film_bottom]\n{film_bottom}\n[surfaces.film_top]\n{film_top}\n\
-         [surfaces.film_edge]\nmodel = \"dielectric\"\ninside = \"film\"\n\
-         [surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\n\
-         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, -5.0]\nnormal = [0.0, 0.0, 1.0]\n\
-         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
-         [detector]\norigin = [-200.0, -200.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
-         size_mm = [400.0, 400.0]\nbins = [4, 4]\nangular_bins = [6, 4]\n"
-    );
-    let (b, t, s) = (
-        quad(0.0, "film_bottom", false),
-        quad(0.2, "film_top", true),
-        quad(-6.0, "sheet", true),
-    );
-    let mut all = vec![
-        ("bottom.obj", b.as_str()),
-        ("top.obj", t.as_str()),
-        ("edge.obj", edge),
-        ("sheet.obj", s.as_str()),
-    ];
-    all.extend_from_slice(files);
-    let run = trace(&load(&write_scene(name, &toml, &all)), 400_000, 9, 2);
-    assert_balanced(&run);
-    run
-}
-
 #[test]
 #[ignore = "slow: characterises a film and traces two stacks (about 5 s in release)"]
 fn a_table_characterised_from_a_ggx_film_traces_like_the_film() {
-    let pet = "[media.film]\nn = 1.58\nabsorption_per_mm = 0.0\n";
-    let film = stack(
-        "ggx-film",
-        "model = \"dielectric\"\ninside = \"film\"",
-        "model = \"diffuser\"\ninside = \"film\"\nroughness = 0.5",
-        pet,
-        &[],
-    );
-    let opts = Options {
-        tag: "film_bottom".into(),
-        photons: 300_000,
-        aoi_deg: vec![
-            0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0, 89.0,
-        ],
-        rotations_deg: vec![0.0],
-        radial_step_deg: 2.0,
-        azimuth_step_deg: 10.0,
-        u_axis: None,
-        seed: 3,
-    };
-    let c = characterise(&film.scene, &opts).unwrap();
-    assert!(
-        c.part.contains("slab of film") && c.part.contains("film_top"),
-        "{}",
-        c.part
-    );
-    let table = format::write(&c.sections, &[]);
-    let gap = "[media.film]\nn = 1.0\nabsorption_per_mm = 0.0\n";
+    let film = stack("ggx-film", GGX_FILM, PET, "", &[]);
+    let table = film_table(&film, "film_bottom", "film_top");
     let tab = stack(
         "ggx-film-table",
-        "model = \"bsdf_table\"\nfile = \"film.bsdf\"\ninside = \"film\"",
-        "model = \"dielectric\"\ninside = \"film\"",
-        gap,
+        (
+            "model = \"bsdf_table\"\nfile = \"film.bsdf\"\ninside = \"film\"",
+            "model = \"dielectric\"\ninside = \"film\"",
+        ),
+        GAP,
+        "",
         &[("film.bsdf", &table)],
     );
     let n = film.tally.ledger.photons as f64;
@@ -479,15 +407,6 @@ fn a_table_characterised_from_a_ggx_film_traces_like_the_film() {
             "polar bin {i}: film {a} vs table {b}"
         );
     }
-}
-
-/// The detected weight per polar bin of the angular tally (its theta runs fastest),
-/// summed over azimuth.
-fn polar_sums(r: &RunResult) -> Vec<f64> {
-    let g = &r.tally.angular;
-    (0..g.nx)
-        .map(|i| (0..g.ny).map(|j| g.bins[j * g.nx + i].sum.value()).sum())
-        .collect()
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! the model built from a `[surfaces.*]` body, photons scattered at it.
 
 use super::{assert_balanced, load, temp_folder, trace, write_scene};
+use blutrace::characterise::{Options, characterise};
 use blutrace::estimator::Estimator;
 use blutrace::geometry::SurfaceHit;
 use blutrace::optics::bsdf_table::format::{self, Block, ScatterType, Section};
@@ -147,4 +148,100 @@ pub fn sheet_run(faces: &str, name: &str, sheet: &str, files: &[(&str, &str)]) -
     let run = trace(&load(&write_scene(name, &toml, &all)), 200_000, 5, 2);
     assert_balanced(&run);
     run
+}
+
+/// The stack of the film tests: a 0.2 mm film (medium `film`, declared in `media`;
+/// 400 x 400 mm, so its edges see almost no light) at z = 0..0.2 over an LED at z = -5
+/// and a Lambertian reflector at z = -6, a detector at z = 1 covering the film (it counts
+/// light going up). `film_bottom` and `film_top` are the faces' `[surfaces.*]` bodies,
+/// `sources` more `[[sources]]` entries; 400,000 photons.
+pub fn stack(
+    name: &str,
+    (film_bottom, film_top): (&str, &str),
+    media: &str,
+    sources: &str,
+    files: &[(&str, &str)],
+) -> RunResult {
+    let quad = |z: f64, tag: &str, up: bool| {
+        let f = if up {
+            "f 1 2 3\nf 1 3 4"
+        } else {
+            "f 1 3 2\nf 1 4 3"
+        };
+        format!(
+            "v -200 -200 {z}\nv 200 -200 {z}\nv 200 200 {z}\nv -200 200 {z}\nusemtl {tag}\n{f}\n"
+        )
+    };
+    let edge = "v -200 -200 0\nv 200 -200 0\nv 200 -200 0.2\nv -200 -200 0.2\nv 200 200 0\nv 200 200 0.2\n\
+                v -200 200 0\nv -200 200 0.2\nusemtl film_edge\nf 1 2 3\nf 1 3 4\nf 2 5 6\nf 2 6 3\n\
+                f 5 7 8\nf 5 8 6\nf 7 1 4\nf 7 4 8\n";
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"bottom.obj\"\n[[geometry]]\nfile = \"top.obj\"\n\
+         [[geometry]]\nfile = \"edge.obj\"\n[[geometry]]\nfile = \"sheet.obj\"\n{media}\n\
+         [surfaces.film_bottom]\n{film_bottom}\n[surfaces.film_top]\n{film_top}\n\
+         [surfaces.film_edge]\nmodel = \"dielectric\"\ninside = \"film\"\n\
+         [surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\n\
+         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, -5.0]\nnormal = [0.0, 0.0, 1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = 2.0\nheight_mm = 2.0\npower_w = 1.0\n\
+         [detector]\norigin = [-200.0, -200.0, 1.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [400.0, 400.0]\nbins = [4, 4]\nangular_bins = [6, 4]\n{sources}"
+    );
+    let (b, t, s) = (
+        quad(0.0, "film_bottom", false),
+        quad(0.2, "film_top", true),
+        quad(-6.0, "sheet", true),
+    );
+    let mut all = vec![
+        ("bottom.obj", b.as_str()),
+        ("top.obj", t.as_str()),
+        ("edge.obj", edge),
+        ("sheet.obj", s.as_str()),
+    ];
+    all.extend_from_slice(files);
+    let run = trace(&load(&write_scene(name, &toml, &all)), 400_000, 9, 2);
+    assert_balanced(&run);
+    run
+}
+
+/// The film of the stack: PET, 1.58, clear.
+pub const PET: &str = "[media.film]\nn = 1.58\nabsorption_per_mm = 0.0\n";
+/// The film's place in a stack of its tables: index 1, so the far face does nothing.
+pub const GAP: &str = "[media.film]\nn = 1.0\nabsorption_per_mm = 0.0\n";
+/// A film smooth below and rough on top (GGX, roughness 0.5): the two faces' bodies.
+pub const GGX_FILM: (&str, &str) = (
+    "model = \"dielectric\"\ninside = \"film\"",
+    "model = \"diffuser\"\ninside = \"film\"\nroughness = 0.5",
+);
+
+/// The IS BSDF table of the film of `run`'s scene lit on face `tag` (its far face
+/// `far`): 300,000 photons at 11 AOIs, 2 x 10 degree cells.
+pub fn film_table(run: &RunResult, tag: &str, far: &str) -> String {
+    let opts = Options {
+        tag: tag.into(),
+        photons: 300_000,
+        aoi_deg: vec![
+            0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0, 89.0,
+        ],
+        rotations_deg: vec![0.0],
+        radial_step_deg: 2.0,
+        azimuth_step_deg: 10.0,
+        u_axis: None,
+        seed: 3,
+    };
+    let c = characterise(&run.scene, &opts).unwrap();
+    assert!(
+        c.part.contains("slab of film") && c.part.contains(far),
+        "{}",
+        c.part
+    );
+    format::write(&c.sections, &[])
+}
+
+/// The detected weight per polar bin of the angular tally (its theta runs fastest),
+/// summed over azimuth.
+pub fn polar_sums(r: &RunResult) -> Vec<f64> {
+    let g = &r.tally.angular;
+    (0..g.nx)
+        .map(|i| (0..g.ny).map(|j| g.bins[j * g.nx + i].sum.value()).sum())
+        .collect()
 }

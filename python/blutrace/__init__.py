@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from ._native import (
     BlutraceError,
+    Characterisation,
     Optimization,
     Run,
     Scene,
@@ -34,6 +35,7 @@ from ._native import (
 
 __all__ = [
     "BlutraceError",
+    "Characterisation",
     "Optimization",
     "Run",
     "Scene",

@@ -101,6 +101,18 @@ class Scene:
         progress: _SearchProgress = ...,
     ) -> Optimization:
         """Optimize the dot density, or with ``vary`` the numbers its key paths name."""
+    def characterise(
+        self,
+        tag: str,
+        photons: Optional[_Count] = None,
+        aoi: Optional[Sequence[float]] = None,
+        rotations: Optional[Sequence[float]] = None,
+        radial_step: float = 2.0,
+        azimuth_step: float = 10.0,
+        u_axis: Optional[Tuple[float, float, float]] = None,
+        seed: Optional[int] = None,
+    ) -> Characterisation:
+        """The part at ``tag`` as an IS BSDF table, as ``blutrace bsdf`` makes it."""
 
 class Run:
     """A finished trace, or the merge of shard runs."""
@@ -155,6 +167,23 @@ class Optimization:
     def interrupted(self) -> bool: ...
     def write(self, dir: _Path) -> List[str]:
         """Write what ``blutrace optimize`` writes into ``dir``, all or nothing."""
+
+class Characterisation:
+    """A part characterised into an IS BSDF table (``Scene.characterise``)."""
+
+    @property
+    def part(self) -> str: ...
+    @property
+    def aoi(self) -> List[float]: ...
+    @property
+    def rotations(self) -> List[float]: ...
+    @property
+    def fates(self) -> Dict[str, npt.NDArray[np.float64]]:
+        """Fractions reflected, transmitted, absorbed, lost: (rotations, aoi) arrays."""
+    def to_bsdf(self) -> str:
+        """The IS BSDF table's text."""
+    def write(self, path: _Path) -> None:
+        """Write the table to ``path``, whole or not at all."""
 
 def merge(runs: Sequence[Run], partial: bool = False) -> Run:
     """Merge shard runs into the run of all their photons, bit for bit."""

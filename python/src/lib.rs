@@ -2,13 +2,15 @@
 //! Python package `blutrace` (`python/blutrace/`) re-exports everything here; its
 //! docstrings and type stubs (`__init__.pyi`) are the user's reference.
 //!
-//! - `scene`: `Scene` (load, key paths, check, trace, optimize);
+//! - `scene`: `Scene` (load, key paths, check, trace, optimize, characterise);
 //! - `run`: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
 //! - `optimization`: `Optimization`, the outcome of `Scene.optimize`;
+//! - `characterisation`: `Characterisation`, a part as a BSDF table (`Scene.characterise`);
 //! - `detached`: long work on a thread of its own, with the GIL released, Ctrl-C
 //!   honoured and panics turned into exceptions;
 //! - `convert`: TOML and JSON values to and from Python objects, and argument checks.
 
+mod characterisation;
 mod convert;
 mod detached;
 mod optimization;
@@ -41,6 +43,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<optimization::Optimization>()?;
+    m.add_class::<characterisation::Characterisation>()?;
     m.add_function(wrap_pyfunction!(run::merge, m)?)?;
     m.add_function(wrap_pyfunction!(run::read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_on_worker, m)?)?;

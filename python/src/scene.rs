@@ -1,6 +1,7 @@
 //! `blutrace.Scene`: a loaded, validated scene as a value (copy, get and set by key path),
-//! and the calls that use it: check, trace, optimize.
+//! and the calls that use it: check, trace, optimize, characterise.
 
+use crate::characterisation::{self, Characterisation};
 use crate::convert::{self, choice, count, py_to_toml, run_error, scene_error, toml_to_py};
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
@@ -273,6 +274,43 @@ impl Scene {
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Optimization> {
         optimization::optimize_scene(py, &self.inner, method, vary, options)
+    }
+
+    /// Characterise a part of the scene into an IS BSDF table, as ``blutrace bsdf`` does:
+    /// the flat face tagged ``tag``, lit from the side its normal points to (or the slab
+    /// behind it, when its model lets light into a medium bounded by a parallel face).
+    /// ``photons`` per incidence (1e6), ``aoi`` the angles of incidence in degrees (0, 10,
+    /// ..., 80, 85), ``rotations`` the sample rotations (one: a plane-symmetric table),
+    /// ``radial_step`` and ``azimuth_step`` the table's cells (2 and 10 degrees),
+    /// ``u_axis`` the direction of rotation 0 on the face, ``seed`` (1). Releases the GIL;
+    /// Ctrl-C stops it before the next incidence. A bad argument or a part that is not one
+    /// flat face raises ``ValueError``.
+    #[pyo3(signature = (tag, photons=None, aoi=None, rotations=None, radial_step=2.0,
+        azimuth_step=10.0, u_axis=None, seed=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn characterise(
+        &self,
+        py: Python<'_>,
+        tag: &str,
+        photons: Option<&Bound<'_, PyAny>>,
+        aoi: Option<Vec<f64>>,
+        rotations: Option<Vec<f64>>,
+        radial_step: f64,
+        azimuth_step: f64,
+        u_axis: Option<[f64; 3]>,
+        seed: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Characterisation> {
+        let args = characterisation::Args {
+            tag,
+            photons,
+            aoi: aoi.unwrap_or_else(|| blutrace::characterise::DEFAULT_AOI_DEG.to_vec()),
+            rotations: rotations.unwrap_or_else(|| vec![0.0]),
+            radial_step,
+            azimuth_step,
+            u_axis,
+            seed,
+        };
+        characterisation::characterise_scene(py, &self.inner, args)
     }
 
     /// A scene pickles as its scene file's text and path (`from_toml` restores it).

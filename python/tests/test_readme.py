@@ -20,3 +20,4 @@ def test_the_readmes_python_example_runs(tmp_path):
     assert lines[0] == "[-2.35, 107.5, 0.325]"
     assert (tmp_path / "out/py-notebook14/flux.exr").is_file()
     assert (tmp_path / "out/py-notebook14-opt/optimized.toml").is_file()
+    assert (tmp_path / "out/sheet.bsdf").read_text().count("DataBegin") == 1

@@ -70,8 +70,7 @@ pub fn bsdf(args: BsdfArgs) -> Result<()> {
         format!("part: {}", c.part),
         format!("{} photons per incidence, seed {}", args.photons, args.seed),
     ];
-    std::fs::write(&out, format::write(&c.sections, &comments))
-        .with_context(|| format!("cannot write {}", out.display()))?;
+    blutrace::output::atomic::write_file(&out, format::write(&c.sections, &comments).as_bytes())?;
     say!("part: {}", c.part);
     say!(
         "{:>8} {:>8} {:>10} {:>10} {:>10}",

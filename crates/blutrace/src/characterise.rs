@@ -37,6 +37,10 @@ use rayon::prelude::*;
 /// Events one photon may meet in the part before it is counted as lost.
 pub const MAX_EVENTS: usize = 100_000;
 
+/// The angles of incidence characterised unless asked otherwise (degrees; `blutrace
+/// bsdf --aoi`'s default).
+pub const DEFAULT_AOI_DEG: [f64; 10] = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0];
+
 /// What to characterise and on which grid.
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -368,6 +372,16 @@ fn check(opts: &Options) -> Result<()> {
 
 /// Characterise the part of `scene` at `opts.tag` into a BRDF and a BTDF section.
 pub fn characterise(scene: &Scene, opts: &Options) -> Result<Characterised> {
+    characterise_until(scene, opts, &|| false)
+}
+
+/// [`characterise`], asking `stop` before each (rotation, AOI): `Err` ("interrupted") as
+/// soon as it says yes (a caller's Ctrl-C; an incidence takes a few seconds at most).
+pub fn characterise_until(
+    scene: &Scene,
+    opts: &Options,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Characterised> {
     check(opts)?;
     let part = Part::find(scene, opts)?;
     let symmetric = opts.rotations_deg.len() == 1;
@@ -382,6 +396,9 @@ pub fn characterise(scene: &Scene, opts: &Options) -> Result<Characterised> {
     let mut fates = Vec::new();
     for (ri, rot) in opts.rotations_deg.iter().enumerate() {
         for (ai, aoi) in opts.aoi_deg.iter().enumerate() {
+            if stop() {
+                bail!("interrupted");
+            }
             let stream = (ri * opts.aoi_deg.len() + ai) as u64;
             let (r, t, f) = one_incidence(&part, &grid, (*rot, *aoi), opts, stream);
             blocks.0.push(r);

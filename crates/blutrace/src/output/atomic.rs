@@ -201,6 +201,31 @@ impl Drop for OutputSet {
     }
 }
 
+/// Write one file whole or not at all: `bytes` go to a hidden temporary file beside `path`
+/// (`.NAME.tmp-PID`), synced, then renamed over `path` in one step; on an error the
+/// temporary is removed and `path` is as it was. Errors name `path`.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path
+        .file_name()
+        .with_context(|| format!("{}: not a file name", path.display()))?;
+    let temp = path.with_file_name(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let written = (|| -> io::Result<()> {
+        let mut f = fs::File::create(&temp)?;
+        io::Write::write_all(&mut f, bytes)?;
+        f.sync_all()?;
+        fs::rename(&temp, path)
+    })();
+    if let Err(e) = written {
+        let _ = fs::remove_file(&temp);
+        bail!("cannot write {}: {e}", path.display());
+    }
+    Ok(())
+}
+
 /// Refuse an output folder the set could not replace without losing something: a file
 /// that is not a folder, a folder holding entries blutrace did not write (neither named by
 /// its manifest nor in `may_write` nor a blutrace temporary), the current directory, or a

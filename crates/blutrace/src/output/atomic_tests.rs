@@ -222,3 +222,23 @@ fn a_folder_created_meanwhile_is_replaced() {
     assert_eq!(fs::read(dest.join("a.json")).unwrap(), b"second");
     assert_eq!(listing(t.path()), vec!["out"]);
 }
+
+#[test]
+fn a_file_is_written_whole_or_left_as_it_was() {
+    let t = parent("file");
+    let path = t.path().join("t.bsdf");
+    write_file(&path, b"old").unwrap();
+    write_file(&path, b"new").unwrap();
+    assert_eq!(fs::read(&path).unwrap(), b"new");
+    assert_eq!(listing(t.path()), vec!["t.bsdf"], "no temporary left");
+    // A folder in the way: an error naming the path, the folder untouched, no temporary.
+    let blocked = t.path().join("dir.bsdf");
+    fs::create_dir(&blocked).unwrap();
+    let e = write_file(&blocked, b"x").unwrap_err().to_string();
+    assert!(
+        e.contains("dir.bsdf") && e.starts_with("cannot write"),
+        "{e}"
+    );
+    assert!(blocked.is_dir());
+    assert_eq!(listing(t.path()), vec!["dir.bsdf", "t.bsdf"]);
+}

@@ -1,0 +1,141 @@
+//! `blutrace.Characterisation`: a part of a scene characterised into an IS BSDF table, what
+//! `Scene.characterise` returns (the library's `blutrace::characterise`, as `blutrace
+//! bsdf` runs it): the part found, the fates per incidence as numpy arrays, and the table
+//! as text or written to a file.
+
+use crate::convert::{count, run_error};
+use crate::detached::run_detached;
+use blutrace::characterise::{Characterised, Fates, Options, characterise_until};
+use blutrace::optics::bsdf_table::format;
+use blutrace::run::Interrupt;
+use blutrace::scene::Scene as RustScene;
+use numpy::IntoPyArray;
+use numpy::ndarray::Array2;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+/// A characterised part (``Scene.characterise``): ``part`` says what was found (the face
+/// alone, or the slab behind it), ``fates`` the fractions of the photons reflected,
+/// transmitted, absorbed and lost at each incidence, ``to_bsdf()`` the IS BSDF table, and
+/// ``write(path)`` writes it for a ``bsdf_table`` face.
+#[pyclass(module = "blutrace", name = "Characterisation", frozen)]
+pub struct Characterisation {
+    inner: Characterised,
+    aoi: Vec<f64>,
+    rotations: Vec<f64>,
+    /// The table's comment lines: how it was made.
+    comments: Vec<String>,
+}
+
+#[pymethods]
+impl Characterisation {
+    /// What the part was found to be.
+    #[getter]
+    fn part(&self) -> String {
+        self.inner.part.clone()
+    }
+
+    /// The angles of incidence (degrees).
+    #[getter]
+    fn aoi(&self) -> Vec<f64> {
+        self.aoi.clone()
+    }
+
+    /// The sample rotations (degrees).
+    #[getter]
+    fn rotations(&self) -> Vec<f64> {
+        self.rotations.clone()
+    }
+
+    /// ``{"reflected", "transmitted", "absorbed", "lost"}``: fractions of the photons, each
+    /// a ``(len(rotations), len(aoi))`` float64 array.
+    #[getter]
+    fn fates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let shape = (self.rotations.len(), self.aoi.len());
+        let d = PyDict::new(py);
+        let fates = &self.inner.fates;
+        let names = ["reflected", "transmitted", "absorbed", "lost"];
+        for (k, name) in names.into_iter().enumerate() {
+            let of = |f: &Fates| [f.reflected, f.transmitted, f.absorbed, f.lost][k];
+            let values = fates.iter().map(of).collect();
+            let a = Array2::from_shape_vec(shape, values).expect("a fate per incidence");
+            d.set_item(name, a.into_pyarray(py))?;
+        }
+        Ok(d)
+    }
+
+    /// The IS BSDF table (the text of a ``.bsdf`` file).
+    fn to_bsdf(&self) -> String {
+        format::write(&self.inner.sections, &self.comments)
+    }
+
+    /// Write the table to ``path`` (a ``.bsdf`` file), whole or not at all.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let text = self.to_bsdf();
+        py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes()))
+            .map_err(run_error)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Characterisation(part={:?}, aoi={:?}, rotations={:?})",
+            self.inner.part, self.aoi, self.rotations
+        )
+    }
+}
+
+/// `Scene.characterise`'s arguments (the CLI's defaults).
+pub struct Args<'a, 'py> {
+    pub tag: &'a str,
+    pub photons: Option<&'a Bound<'py, PyAny>>,
+    pub aoi: Vec<f64>,
+    pub rotations: Vec<f64>,
+    pub radial_step: f64,
+    pub azimuth_step: f64,
+    pub u_axis: Option<[f64; 3]>,
+    pub seed: Option<&'a Bound<'py, PyAny>>,
+}
+
+/// Characterise the part of `scene` that `args` name, off the GIL; Ctrl-C stops it before
+/// the next incidence and raises.
+pub fn characterise_scene(
+    py: Python<'_>,
+    scene: &RustScene,
+    args: Args<'_, '_>,
+) -> PyResult<Characterisation> {
+    let photons = args
+        .photons
+        .map_or(Ok(1_000_000), |p| count(p, "photons", 1))?;
+    let seed = args.seed.map_or(Ok(1), |s| count(s, "seed", 0))?;
+    let opts = Options {
+        tag: args.tag.to_string(),
+        photons,
+        aoi_deg: args.aoi,
+        rotations_deg: args.rotations,
+        radial_step_deg: args.radial_step,
+        azimuth_step_deg: args.azimuth_step,
+        u_axis: args.u_axis,
+        seed,
+    };
+    let interrupt = Interrupt::default();
+    let work = || characterise_until(scene, &opts, &|| interrupt.requested());
+    let inner = run_detached(py, &interrupt, work, |_| Ok(()))?
+        .map_err(|e| PyValueError::new_err(format!("{}: {e:#}", scene.path.display())))?;
+    let comments = vec![
+        format!(
+            "blutrace Scene.characterise of {} at tag {}",
+            scene.path.display(),
+            opts.tag
+        ),
+        format!("part: {}", inner.part),
+        format!("{photons} photons per incidence, seed {seed}"),
+    ];
+    Ok(Characterisation {
+        inner,
+        aoi: opts.aoi_deg,
+        rotations: opts.rotations_deg,
+        comments,
+    })
+}

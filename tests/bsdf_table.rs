@@ -9,7 +9,7 @@
 
 mod support;
 
-use blutrace::characterise::{Options, characterise};
+use blutrace::characterise::{Options, characterise, characterise_until};
 use blutrace::estimator::Estimator;
 use blutrace::optics::bsdf_table::format::{self, ScatterType};
 use blutrace::run::RunResult;
@@ -430,6 +430,11 @@ fn characterising_a_lambert_sheet_gives_back_its_albedo_and_shape() {
         u_axis: None,
         seed: 1,
     };
+    // Asked to stop after two incidences: it stops there, with an error.
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let stop = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 2;
+    let e = characterise_until(&scene, &opts, &stop).unwrap_err();
+    assert!(format!("{e:#}").contains("interrupted") && asked.into_inner() == 3);
     let c = characterise(&scene, &opts).unwrap();
     assert!(c.part.contains("alone"), "{}", c.part);
     let sigma = (0.6 * 0.4 / n as f64).sqrt();

@@ -430,11 +430,14 @@ fn characterising_a_lambert_sheet_gives_back_its_albedo_and_shape() {
         u_axis: None,
         seed: 1,
     };
-    // Asked to stop after two incidences: it stops there, with an error.
-    let asked = std::sync::atomic::AtomicUsize::new(0);
-    let stop = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 2;
+    // Asked before each incidence with the number done; told to stop after two, it stops.
+    let asked = std::cell::RefCell::new(Vec::new());
+    let stop = |done| {
+        asked.borrow_mut().push(done);
+        done == 2
+    };
     let e = characterise_until(&scene, &opts, &stop).unwrap_err();
-    assert!(format!("{e:#}").contains("interrupted") && asked.into_inner() == 3);
+    assert!(format!("{e:#}").contains("interrupted") && asked.into_inner() == [0, 1, 2]);
     let c = characterise(&scene, &opts).unwrap();
     assert!(c.part.contains("alone"), "{}", c.part);
     let sigma = (0.6 * 0.4 / n as f64).sqrt();

@@ -111,6 +111,7 @@ class Scene:
         azimuth_step: float = 10.0,
         u_axis: Optional[Tuple[float, float, float]] = None,
         seed: Optional[int] = None,
+        progress: _TraceProgress = None,
     ) -> Characterisation:
         """The part at ``tag`` as an IS BSDF table, as ``blutrace bsdf`` makes it."""
 

@@ -5,6 +5,7 @@
 
 use crate::convert::{count, run_error};
 use crate::detached::run_detached;
+use crate::progress;
 use blutrace::characterise::{Characterised, Fates, Options, characterise_until};
 use blutrace::optics::bsdf_table::format;
 use blutrace::run::Interrupt;
@@ -15,6 +16,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A characterised part (``Scene.characterise``): ``part`` says what was found (the face
 /// alone, or the slab behind it), ``fates`` the fractions of the photons reflected,
@@ -96,10 +98,12 @@ pub struct Args<'a, 'py> {
     pub azimuth_step: f64,
     pub u_axis: Option<[f64; 3]>,
     pub seed: Option<&'a Bound<'py, PyAny>>,
+    pub progress: Option<&'a Bound<'py, PyAny>>,
 }
 
-/// Characterise the part of `scene` that `args` name, off the GIL; Ctrl-C stops it before
-/// the next incidence and raises.
+/// Characterise the part of `scene` that `args` name, off the GIL, reporting photons done
+/// (whole incidences) to `args.progress`; Ctrl-C stops it before the next incidence and
+/// raises.
 pub fn characterise_scene(
     py: Python<'_>,
     scene: &RustScene,
@@ -119,10 +123,28 @@ pub fn characterise_scene(
         u_axis: args.u_axis,
         seed,
     };
+    let total = photons.saturating_mul((opts.aoi_deg.len() * opts.rotations_deg.len()) as u64);
+    let reporter = progress::reporter(py, args.progress, total)?;
+    let done = AtomicU64::new(0);
     let interrupt = Interrupt::default();
-    let work = || characterise_until(scene, &opts, &|| interrupt.requested());
-    let inner = run_detached(py, &interrupt, work, |_| Ok(()))?
-        .map_err(|e| PyValueError::new_err(format!("{}: {e:#}", scene.path.display())))?;
+    let stop = |k: usize| {
+        done.store(k as u64 * photons, Ordering::Relaxed);
+        interrupt.requested()
+    };
+    let work = || characterise_until(scene, &opts, &stop);
+    let tick = |py: Python<'_>| progress::update(py, &reporter, done.load(Ordering::Relaxed));
+    let made = run_detached(py, &interrupt, work, tick);
+    // An interrupt or an error of the work outranks one of the progress display.
+    let finished = matches!(made, Ok(Ok(_)));
+    let last = if finished {
+        total
+    } else {
+        done.load(Ordering::Relaxed)
+    };
+    let closed = progress::close(py, &reporter, last);
+    let inner =
+        made?.map_err(|e| PyValueError::new_err(format!("{}: {e:#}", scene.path.display())))?;
+    closed?;
     let comments = vec![
         format!(
             "blutrace Scene.characterise of {} at tag {}",

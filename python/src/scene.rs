@@ -282,11 +282,12 @@ impl Scene {
     /// ``photons`` per incidence (1e6), ``aoi`` the angles of incidence in degrees (0, 10,
     /// ..., 80, 85), ``rotations`` the sample rotations (one: a plane-symmetric table),
     /// ``radial_step`` and ``azimuth_step`` the table's cells (2 and 10 degrees),
-    /// ``u_axis`` the direction of rotation 0 on the face, ``seed`` (1). Releases the GIL;
-    /// Ctrl-C stops it before the next incidence. A bad argument or a part that is not one
-    /// flat face raises ``ValueError``.
+    /// ``u_axis`` the direction of rotation 0 on the face, ``seed`` (1); ``progress`` as
+    /// ``trace``'s, over the photons of all incidences (reported an incidence at a time).
+    /// Releases the GIL; Ctrl-C stops it before the next incidence. A bad argument or a
+    /// part that is not one flat face raises ``ValueError``.
     #[pyo3(signature = (tag, photons=None, aoi=None, rotations=None, radial_step=2.0,
-        azimuth_step=10.0, u_axis=None, seed=None))]
+        azimuth_step=10.0, u_axis=None, seed=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn characterise(
         &self,
@@ -299,6 +300,7 @@ impl Scene {
         azimuth_step: f64,
         u_axis: Option<[f64; 3]>,
         seed: Option<&Bound<'_, PyAny>>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Characterisation> {
         let args = characterisation::Args {
             tag,
@@ -309,6 +311,7 @@ impl Scene {
             azimuth_step,
             u_axis,
             seed,
+            progress,
         };
         characterisation::characterise_scene(py, &self.inner, args)
     }

@@ -77,3 +77,21 @@ def test_the_written_table_is_a_bsdf_table_face(sheet, tmp_path):
 def test_a_bad_argument_is_a_value_error_naming_it(sheet, kwargs, says):
     with pytest.raises(ValueError, match=says):
         sheet.characterise(**kwargs)
+
+
+def test_progress_hears_the_photons_of_every_incidence(sheet):
+    seen = []
+    sheet.characterise(
+        "sheet", photons=10_000, aoi=[0, 30, 60, 80], progress=lambda d, t: seen.append((d, t))
+    )
+    assert seen and seen[-1] == (40_000, 40_000)
+    assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
+    assert all(d % 10_000 == 0 for d, _ in seen), "whole incidences"
+
+
+def test_an_exception_of_the_progress_callable_stops_it(sheet):
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        sheet.characterise("sheet", photons=2_000_000, aoi=list(range(0, 90, 5)), progress=fail)

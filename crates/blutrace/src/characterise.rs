@@ -372,15 +372,16 @@ fn check(opts: &Options) -> Result<()> {
 
 /// Characterise the part of `scene` at `opts.tag` into a BRDF and a BTDF section.
 pub fn characterise(scene: &Scene, opts: &Options) -> Result<Characterised> {
-    characterise_until(scene, opts, &|| false)
+    characterise_until(scene, opts, &|_| false)
 }
 
-/// [`characterise`], asking `stop` before each (rotation, AOI): `Err` ("interrupted") as
-/// soon as it says yes (a caller's Ctrl-C; an incidence takes a few seconds at most).
+/// [`characterise`], asking `stop` before each (rotation, AOI) with the number of
+/// incidences done (for a progress report): `Err` ("interrupted") as soon as it says yes
+/// (a caller's Ctrl-C; an incidence takes a few seconds at most).
 pub fn characterise_until(
     scene: &Scene,
     opts: &Options,
-    stop: &(dyn Fn() -> bool + Sync),
+    stop: &dyn Fn(usize) -> bool,
 ) -> Result<Characterised> {
     check(opts)?;
     let part = Part::find(scene, opts)?;
@@ -396,10 +397,11 @@ pub fn characterise_until(
     let mut fates = Vec::new();
     for (ri, rot) in opts.rotations_deg.iter().enumerate() {
         for (ai, aoi) in opts.aoi_deg.iter().enumerate() {
-            if stop() {
+            let done = ri * opts.aoi_deg.len() + ai;
+            if stop(done) {
                 bail!("interrupted");
             }
-            let stream = (ri * opts.aoi_deg.len() + ai) as u64;
+            let stream = done as u64;
             let (r, t, f) = one_incidence(&part, &grid, (*rot, *aoi), opts, stream);
             blocks.0.push(r);
             blocks.1.push(t);

@@ -196,7 +196,7 @@ fn a_back_that_cannot_be_is_an_error_naming_its_field() {
 }
 
 #[test]
-fn the_content_hash_covers_the_back() {
+fn the_content_hash_and_check_cover_the_back() {
     let toml = "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\n\
                 model = \"bsdf_table\"\nfile = \"w.bsdf\"\nback_file = \"k.bsdf\"\n\
                 [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\nnormal = [0.0, 0.0, -1.0]\n\
@@ -215,6 +215,10 @@ fn the_content_hash_covers_the_back() {
     };
     let (a, b) = (scene("bsdf-back-a", 0.05), scene("bsdf-back-b", 0.06));
     assert_ne!(load(&a).content_hash(), load(&b).content_hash());
+    // `check --json` says the back has tables of its own.
+    let loaded = load(&a);
+    let report = blutrace::scene::check_report::check_json(&loaded, &a).unwrap();
+    assert_eq!(report["surfaces"][0]["back"], "bsdf_table (back_file)");
 }
 
 /// An LED at z = 5 over the film stack, facing down: it lights the film's top, and what

@@ -130,10 +130,8 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
             }
             _ => String::new(),
         };
-        let back = match &scene.backs[t] {
-            Some(b) => format!(", back {}", b.kind()),
-            None => String::new(),
-        };
+        let back = two_sided::back_kind(model, scene.backs[t].as_ref())
+            .map_or(String::new(), |b| format!(", back {b}"));
         let facing = two_sided::facing(&scene.mesh, t as u32)
             .iter()
             .map(|(way, k)| format!("{way} {k}"))

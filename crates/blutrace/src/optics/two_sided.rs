@@ -109,6 +109,19 @@ pub fn met<'a>(
     }
 }
 
+/// What a surface's back is, for reports: its back model's kind, `"bsdf_table
+/// (back_file)"` for a table face with tables of its own for the back, or `None` when the
+/// back is the front.
+pub fn back_kind(front: &SurfaceModel, back: Option<&SurfaceModel>) -> Option<String> {
+    match (front, back) {
+        (_, Some(b)) => Some(b.kind().to_string()),
+        (SurfaceModel::BsdfTable(t), None) if t.back.is_some() => {
+            Some("bsdf_table (back_file)".to_string())
+        }
+        _ => None,
+    }
+}
+
 /// How many of tag `tag`'s triangles face each way: counts by the axis their normal
 /// points along most (`"+z"`, `"-x"`, ...), in axis order, the ways no triangle faces left
 /// out. A sheet's front is the side its counted normals point to.

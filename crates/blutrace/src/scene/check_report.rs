@@ -48,7 +48,7 @@ fn surfaces_json(scene: &Scene) -> Vec<serde_json::Value> {
             serde_json::json!({
                 "tag": scene.tags[t],
                 "model": scene.surfaces[t].kind(),
-                "back": scene.backs[t].as_ref().map(|b| b.kind()),
+                "back": two_sided::back_kind(&scene.surfaces[t], scene.backs[t].as_ref()),
                 "triangles": counts[t],
                 "facing": facing,
             })

@@ -182,15 +182,8 @@ fn wavelengths_and_flux_weights_reach_the_photons() {
     assert_eq!(s.power_w, 1.0, "power_w defaults to the file's total flux");
     let efficacy = s.luminous_flux().unwrap();
     assert!(efficacy > 20.0 && efficacy < 200.0, "{efficacy} lm");
-    let n = 40_000;
-    let r = trace(&scene, n, 3, 2);
-    assert_balanced(&r);
-    let detected = r.tally.ledger.detected.sum.value() / n as f64;
-    let se = (0.75f64 * 0.25 / n as f64).sqrt();
-    assert!(
-        (detected - 0.75).abs() < 4.0 * se,
-        "detected {detected}, expected 0.75 (the 650 nm flux share)"
-    );
+    // The 650 nm flux share.
+    assert_detects(&scene, 3, 0.75);
     // Half the photons per ray (flux ignored) would detect 0.5; every photon at 555 nm
     // (wavelengths ignored) 1; wavelengths drawn from the file's spectrum instead of
     // going with their rays 0.75 + 0.25 x 0.75 = 0.9375.
@@ -457,15 +450,20 @@ fn photons_trace_with_their_rays_tables() {
         &[("mirror.obj", MIRROR)],
     );
     tm25::write(&dir.parent().unwrap().join("x.TM25RAY"), &set).unwrap();
-    let scene = load(&dir);
+    assert_detects(&load(&dir), 5, 0.6);
+}
+
+/// 40,000 photons of `scene` (seed `seed`), balanced, detect the fraction `p` within 4
+/// standard errors.
+fn assert_detects(scene: &Scene, seed: u64, p: f64) {
     let n = 40_000;
-    let r = trace(&scene, n, 5, 2);
+    let r = trace(scene, n, seed, 2);
     assert_balanced(&r);
     let detected = r.tally.ledger.detected.sum.value() / n as f64;
-    let se = (0.6f64 * 0.4 / n as f64).sqrt();
+    let se = (p * (1.0 - p) / n as f64).sqrt();
     assert!(
-        (detected - 0.6).abs() < 4.0 * se,
-        "detected {detected}, expected 0.6"
+        (detected - p).abs() < 4.0 * se,
+        "detected {detected}, expected {p}"
     );
 }
 

@@ -481,7 +481,7 @@ impl RunResult {
             summary::convergence_csv(&self.history).as_bytes(),
         )?;
         staged.write_with("convergence.png", |chart| {
-            summary::write_convergence_png(chart, &self.history)
+            summary::write_convergence_png(chart, &self.scene.name, &self.history)
         })?;
         let json = serde_json::to_vec_pretty(&self.summary())?;
         staged.write_bytes("summary.json", &json)?;

@@ -345,17 +345,18 @@ pub fn convergence_csv(history: &[ConvergenceRow]) -> String {
     s
 }
 
-/// Relative error against run time, with the 1/sqrt(t) reference line; see
-/// [`convergence_chart`].
-pub fn write_convergence_png(path: &Path, history: &[ConvergenceRow]) -> Result<()> {
-    write_chart(path, &convergence_chart(history))
+/// Relative error against run time of the scene named `scene`, with the 1/sqrt(t)
+/// reference line; see [`convergence_chart`].
+pub fn write_convergence_png(path: &Path, scene: &str, history: &[ConvergenceRow]) -> Result<()> {
+    write_chart(path, &convergence_chart(scene, history))
 }
 
 /// The chart of `convergence.png`: relative standard errors against tracing time and the
 /// 1/sqrt(t) line through the first round's error of the mean flux, over the rounds' time
 /// span only. Each axis is logarithmic when its data span at least a decade, else linear
 /// (two rounds of a short run span a factor of two, which a log axis would pad to decades).
-pub fn convergence_chart(history: &[ConvergenceRow]) -> Chart {
+/// The title names the scene, `scene`, as the maps' titles do.
+pub fn convergence_chart(scene: &str, history: &[ConvergenceRow]) -> Chart {
     let shown = [
         (Metric::Mean, "mean flux"),
         (Metric::Efficiency, "efficiency"),
@@ -400,7 +401,7 @@ pub fn convergence_chart(history: &[ConvergenceRow]) -> Chart {
         });
     }
     Chart {
-        title: "Monte Carlo error against run time".into(),
+        title: format!("{scene}: Monte Carlo error against run time"),
         x_label: "tracing time (s)".into(),
         y_label: "relative standard error".into(),
         x_scale,
@@ -453,7 +454,8 @@ mod tests {
 
     #[test]
     fn two_rounds_of_a_short_run_get_linear_axes_over_the_run() {
-        let chart = convergence_chart(&history(&[1.5, 2.0]));
+        let chart = convergence_chart("box", &history(&[1.5, 2.0]));
+        assert_eq!(chart.title, "box: Monte Carlo error against run time");
         assert_eq!(chart.x_scale, Scale::Linear);
         // The errors (0.007 to 1 here: the bins' error is a relative error itself) do
         // span decades.
@@ -473,12 +475,12 @@ mod tests {
     #[test]
     fn runs_over_decades_get_log_axes_spanning_the_data() {
         let times: Vec<f64> = (0..12).map(|k| 0.1 * 2f64.powi(k)).collect();
-        let chart = convergence_chart(&history(&times));
+        let chart = convergence_chart("box", &history(&times));
         assert_eq!(chart.x_scale, Scale::Log10);
         let (lo, hi) = time_range(&chart);
         assert_eq!((lo, hi), (0.1, times[11]));
         // One round: no reference line, nothing beyond the data.
-        let chart = convergence_chart(&history(&[2.0]));
+        let chart = convergence_chart("box", &history(&[2.0]));
         assert_eq!(chart.series.len(), 5);
         assert_eq!(time_range(&chart), (2.0, 2.0));
     }

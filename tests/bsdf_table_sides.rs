@@ -230,8 +230,9 @@ const LED_ABOVE: &str = "[[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 5.0]\n
 /// The film smooth below and GGX-rough on top, lit from below and from above, against
 /// its two characterised tables on one face (`file`: the film lit on its bottom,
 /// `back_file`: lit on its top): the same detected power and polar distribution within 3
-/// standard errors plus the table's approximation (0.3 % and 1.5 %). Without `back_file`
-/// the top is taken to scatter as the bottom, which the polar distribution shows.
+/// standard errors plus the table's approximation (0.2 % and 1 %, as for the film lit
+/// from below in `tests/bsdf_table.rs`). Without `back_file` the top is taken to scatter
+/// as the bottom, which the polar distribution shows.
 // About 3 s in release: in the default suite.
 #[test]
 fn a_film_lit_from_both_sides_traces_like_its_two_tables() {
@@ -254,7 +255,7 @@ fn a_film_lit_from_both_sides_traces_like_its_two_tables() {
     eprintln!("film {df} {pf:?}\ntables {dt} {pt:?}\nfront only {d1} {p1:?}");
     let sigma = (df * (1.0 - df) / n + dt * (1.0 - dt) / n).sqrt();
     assert!(
-        (df - dt).abs() < 3.0 * sigma + 0.003 * df,
+        (df - dt).abs() < 3.0 * sigma + 0.002 * df,
         "film {df} vs tables {dt} (sigma {sigma})"
     );
     // Binomial errors of a bin's detected photons (weight 1 each).
@@ -262,7 +263,7 @@ fn a_film_lit_from_both_sides_traces_like_its_two_tables() {
     let off = |p: &[f64]| {
         pf.iter()
             .zip(p)
-            .map(|(a, b)| (a - b).abs() / (3.0 * s(*a, *b) + 0.015 * a))
+            .map(|(a, b)| (a - b).abs() / (3.0 * s(*a, *b) + 0.01 * a))
             .fold(0.0, f64::max)
     };
     assert!(off(&pt) < 1.0, "polar: film {pf:?} vs tables {pt:?}");

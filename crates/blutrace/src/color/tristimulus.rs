@@ -46,6 +46,19 @@ pub struct Xyz {
     pub z: f64,
 }
 
+impl std::ops::Add for Xyz {
+    type Output = Xyz;
+
+    /// Channel by channel: the tristimulus values of two lights together.
+    fn add(self, o: Xyz) -> Xyz {
+        Xyz {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
 /// CIE 1931 chromaticity coordinates x, y.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Xy {
@@ -86,6 +99,13 @@ impl Xyz {
         let xyz = Xyz::of(spd);
         (xyz.y > 0.0).then(|| xyz.scaled(100.0 / xyz.y))
     }
+
+    /// Zero in every channel.
+    pub const ZERO: Xyz = Xyz {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
 
     /// These values times `k`.
     pub fn scaled(self, k: f64) -> Xyz {

@@ -332,6 +332,30 @@ impl RaySet {
         }))
     }
 
+    /// With [`FileSpectrum::Tables`], that every ray has a table index and every index
+    /// names one of the tables (what the reader checks of a file; a set built in code may
+    /// not hold it).
+    pub fn check_table_indices(&self) -> Result<()> {
+        let FileSpectrum::Tables(tables) = &self.spectrum else {
+            return Ok(());
+        };
+        if self.table.len() != self.rays.len() {
+            bail!(
+                "{} rays but {} spectral table indices",
+                self.rays.len(),
+                self.table.len()
+            );
+        }
+        if let Some(i) = self.table.iter().position(|&t| t as usize >= tables.len()) {
+            bail!(
+                "ray {i}: spectral table {} of {}",
+                self.table[i] as usize + 1,
+                tables.len()
+            );
+        }
+        Ok(())
+    }
+
     /// The emission spectrum of each of the set's tables ([`FileSpectrum::Tables`]; empty
     /// for any other), as [`FileSpectrum::Table`]'s: `Err` names a table without power
     /// within 360-830 nm (numbered from 1, as TM-25 does).

@@ -270,22 +270,10 @@ impl EmissionSpectrum {
             .map(|&k| [k, parts.iter().map(|(w, s)| w / total * s.density(k)).sum()])
             .collect();
         let mut mix = EmissionSpectrum::new(&Spectrum::from_rows(&rows).ok()?)?;
-        let xyz = parts.iter().fold(
-            Xyz {
-                x: 0.0,
-                y: 0.0,
-                z: 0.0,
-            },
-            |a, (w, s)| {
-                let b = s.xyz_per_w.scaled(w / total);
-                Xyz {
-                    x: a.x + b.x,
-                    y: a.y + b.y,
-                    z: a.z + b.z,
-                }
-            },
-        );
-        mix.xyz_per_w = xyz;
+        mix.xyz_per_w = parts
+            .iter()
+            .map(|(w, s)| s.xyz_per_w.scaled(w / total))
+            .fold(Xyz::ZERO, |a, b| a + b);
         Some(mix)
     }
 

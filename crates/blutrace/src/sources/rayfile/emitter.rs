@@ -7,7 +7,7 @@ use crate::rng::PhotonRng;
 use crate::sources::body_shape::{BodyShape, Rect};
 use crate::sources::led::{FlatLed, LedProfile};
 use crate::sources::spectrum::EmissionSpectrum;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use glam::{DMat3, DVec3};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -100,27 +100,7 @@ impl RayFileEmitter {
         shift: DVec3,
     ) -> Result<Self> {
         let spectra = set.table_spectra()?;
-        if matches!(set.spectrum, FileSpectrum::Tables(_)) {
-            if set.table.len() != set.rays.len() {
-                bail!(
-                    "{} rays but {} spectral table indices",
-                    set.rays.len(),
-                    set.table.len()
-                );
-            }
-            if let Some((i, t)) = set
-                .table
-                .iter()
-                .enumerate()
-                .find(|(_, t)| **t as usize >= spectra.len())
-            {
-                bail!(
-                    "ray {i}: spectral table {} of {}",
-                    *t as usize + 1,
-                    spectra.len()
-                );
-            }
-        }
+        set.check_table_indices()?;
         let alias = Arc::new(Alias::new(set.rays.iter().map(|r| r.flux as f64)));
         let (lo, hi) = set.bounds();
         let mid = DVec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z);

@@ -615,20 +615,7 @@ fn check_writable(set: &RaySet) -> Result<()> {
             if let Some(k) = tables.iter().position(|rows| rows.is_empty()) {
                 bail!("spectral table {} has no rows", k + 1);
             }
-            if set.table.len() != set.rays.len() {
-                bail!(
-                    "{} rays but {} spectral table indices",
-                    set.rays.len(),
-                    set.table.len()
-                );
-            }
-            if let Some(i) = set.table.iter().position(|&t| t as usize >= tables.len()) {
-                bail!(
-                    "ray {i}: spectral table {} of {}",
-                    set.table[i] as usize + 1,
-                    tables.len()
-                );
-            }
+            set.check_table_indices()?;
         }
         _ => {}
     }

@@ -29,6 +29,8 @@ pub struct Characterisation {
     rotations: Vec<f64>,
     /// The table's comment lines: how it was made.
     comments: Vec<String>,
+    /// The files the scene read, which `write` must not replace.
+    reads: Vec<PathBuf>,
 }
 
 #[pymethods]
@@ -76,7 +78,7 @@ impl Characterisation {
     /// Write the table to ``path`` (a ``.bsdf`` file), whole or not at all.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let text = self.to_bsdf();
-        py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes()))
+        py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes(), &self.reads))
             .map_err(run_error)
     }
 
@@ -159,5 +161,6 @@ pub fn characterise_scene(
         aoi: opts.aoi_deg,
         rotations: opts.rotations_deg,
         comments,
+        reads: scene.inputs.clone(),
     })
 }

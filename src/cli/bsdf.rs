@@ -60,17 +60,20 @@ pub fn bsdf(args: BsdfArgs) -> Result<()> {
         u_axis: args.u_axis.map(|u| [u[0], u[1], u[2]]),
         seed: args.seed,
     };
-    let start = std::time::Instant::now();
-    let c = characterise(&scene, &opts).with_context(|| format!("{}", scene.path.display()))?;
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{}.bsdf", args.tag)));
+    // Refused before the work, not after it.
+    blutrace::output::atomic::check_apart(&out, &scene.inputs)?;
+    let start = std::time::Instant::now();
+    let c = characterise(&scene, &opts).with_context(|| format!("{}", scene.path.display()))?;
     let comments = [
         format!("blutrace bsdf {} --tag {}", scene.path.display(), args.tag),
         format!("part: {}", c.part),
         format!("{} photons per incidence, seed {}", args.photons, args.seed),
     ];
-    blutrace::output::atomic::write_file(&out, format::write(&c.sections, &comments).as_bytes())?;
+    let table = format::write(&c.sections, &comments);
+    blutrace::output::atomic::write_file(&out, table.as_bytes(), &scene.inputs)?;
     say!("part: {}", c.part);
     say!(
         "{:>8} {:>8} {:>10} {:>10} {:>10}",

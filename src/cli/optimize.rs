@@ -92,7 +92,7 @@ fn run_density(
             scene.name, options.method
         ))
     });
-    blutrace::output::atomic::check_dest(&out, blutrace::optimize::OUTPUT_NAMES)?;
+    blutrace::output::atomic::check_dest(&out, blutrace::optimize::OUTPUT_NAMES, &scene.inputs)?;
     let objective = if options.tunes_grid() {
         "area cv of the flux map (2-D density grid)".to_string()
     } else if options.objective.reads_color() {
@@ -136,7 +136,11 @@ fn run_layout(
             scene.name, options.method
         ))
     });
-    blutrace::output::atomic::check_dest(&out, blutrace::optimize::LAYOUT_OUTPUT_NAMES)?;
+    blutrace::output::atomic::check_dest(
+        &out,
+        blutrace::optimize::LAYOUT_OUTPUT_NAMES,
+        &scene.inputs,
+    )?;
     say!(
         "optimize   {} ({}) by {} over {} variable(s): {} photons per design, seed {}, objective = {}",
         scene.name,

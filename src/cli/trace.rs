@@ -6,7 +6,7 @@ use super::{default_out, scene_path, word};
 use anyhow::{Result, bail};
 use blutrace::accel::BackendChoice;
 use blutrace::estimator::Estimator;
-use blutrace::output::atomic::{check_apart, check_dest};
+use blutrace::output::atomic::check_dest;
 use blutrace::run::{self, Progress, RunOptions, Shard, StoppedBy, TargetMetric};
 use blutrace::scene::Scene;
 use blutrace::shard;
@@ -121,7 +121,7 @@ pub(super) fn trace(args: TraceArgs, quiet: bool) -> Result<ExitCode> {
     } else {
         run::OUTPUT_NAMES
     };
-    check_dest(&out, names)?;
+    check_dest(&out, names, &scene.inputs)?;
     let (first, last) = options.photon_range();
     let bar = progress_bar(
         &options,
@@ -409,9 +409,9 @@ pub(super) fn merge(args: MergeArgs) -> Result<ExitCode> {
             list.join(", ")
         );
     }
-    let inputs: Vec<&std::path::Path> = args.shards.iter().map(PathBuf::as_path).collect();
-    check_apart(&args.out, &inputs)?;
-    check_dest(&args.out, run::OUTPUT_NAMES)?;
+    let mut inputs: Vec<PathBuf> = args.shards.clone();
+    inputs.extend(scene.inputs.iter().cloned());
+    check_dest(&args.out, run::OUTPUT_NAMES, &inputs)?;
     let result = shard::merge(&shards, &scene)?;
     if interrupt.requested() {
         eprintln!("interrupted before the merged outputs were written: nothing written");

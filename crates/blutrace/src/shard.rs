@@ -96,7 +96,7 @@ impl ShardFile {
 /// Write `result` (a shard run) as `dir/shard.json`, atomically.
 pub fn write_shard(result: &RunResult, dir: &Path) -> Result<PathBuf> {
     let file = ShardFile::of(result)?;
-    let staged = OutputSet::new(dir, &[SHARD_FILE])?;
+    let staged = OutputSet::new(dir, &[SHARD_FILE], &result.scene.inputs)?;
     let path = staged.write_bytes(SHARD_FILE, &serde_json::to_vec(&file)?)?;
     staged.commit()?;
     Ok(path)

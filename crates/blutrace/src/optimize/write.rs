@@ -84,7 +84,7 @@ impl OptimizeResult {
             .map_err(|e| anyhow::anyhow!("optimized scene does not parse: {e}"))?;
         Scene::from_file(&file, &dest).context("the optimized scene does not load")?;
 
-        let staged = OutputSet::new(dir, OUTPUT_NAMES)?;
+        let staged = OutputSet::new(dir, OUTPUT_NAMES, &self.initial_run.scene.inputs)?;
         staged.write_bytes("optimized.toml", toml_text.as_bytes())?;
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         self.write_charts(&staged)?;

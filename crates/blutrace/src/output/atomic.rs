@@ -19,7 +19,8 @@
 //! removes its staging folder at once. Errors name the final path (`out/x/flux.exr`), never
 //! the staging path.
 //!
-//! The set replaces the whole folder, so `dest` must be new, empty, or hold only what
+//! The set replaces the whole folder, so `dest` must not be or hold a file the run read
+//! (its scene, meshes, tables: [`check_apart`]), and must be new, empty, or hold only what
 //! blutrace wrote there: the entries its manifest names, or (folders written before
 //! manifests existed) names the command itself writes. Anything else is refused with an
 //! error naming it, before tracing when the command calls [`check_dest`] first, and never
@@ -34,7 +35,8 @@
 //! ```no_run
 //! # fn main() -> anyhow::Result<()> {
 //! use blutrace::output::atomic::OutputSet;
-//! let out = OutputSet::new(std::path::Path::new("results"), &["summary.json", "map.png"])?;
+//! let reads: [&std::path::Path; 0] = []; // the files the run read
+//! let out = OutputSet::new(std::path::Path::new("results"), &["summary.json", "map.png"], &reads)?;
 //! out.write_bytes("summary.json", b"{}")?;
 //! out.write_with("map.png", |path| Ok(std::fs::write(path, b"")?))?;
 //! let written = out.commit()?; // results/map.png, results/summary.json
@@ -120,6 +122,8 @@ pub struct OutputSet {
     dest: PathBuf,
     /// Names the command may write, accepted in a folder without a manifest.
     may_write: Vec<String>,
+    /// The files the run read, which the set must not replace.
+    reads: Vec<PathBuf>,
     /// Moved into place (so `Drop` must not remove the staging folder).
     committed: bool,
 }
@@ -133,12 +137,15 @@ impl Deref for OutputSet {
 
 impl OutputSet {
     /// Start a set that will replace the folder `dest`. `may_write` lists the names the
-    /// command can write (for [`check_dest`]). Restores or removes what killed runs left
-    /// (see the module documentation), checks `dest` and creates the staging folder.
-    pub fn new(dest: &Path, may_write: &[&str]) -> Result<Self> {
+    /// command can write (for [`check_dest`]); `reads` the files the run read, which
+    /// `dest` must not be or hold ([`check_apart`]). Restores or removes what killed runs
+    /// left (see the module documentation), checks `dest` and creates the staging folder.
+    pub fn new<P: AsRef<Path>>(dest: &Path, may_write: &[&str], reads: &[P]) -> Result<Self> {
+        let reads: Vec<PathBuf> = reads.iter().map(|p| p.as_ref().to_path_buf()).collect();
+        check_apart(dest, &reads)?;
         let (parent, name) = split_dest(dest)?;
         recover(&parent, &name, dest);
-        check_dest(dest, may_write)?;
+        check_dest(dest, may_write, &reads)?;
         let abs = parent.join(&name);
         let n = STAGE_COUNTER.fetch_add(1, Ordering::Relaxed);
         let staging = parent.join(temp_name(&name, "tmp", std::process::id(), n));
@@ -151,6 +158,7 @@ impl OutputSet {
             },
             dest: abs,
             may_write: may_write.iter().map(|s| s.to_string()).collect(),
+            reads,
             committed: false,
         })
     }
@@ -162,7 +170,7 @@ impl OutputSet {
         let entries = entry_names(&self.root.staging)?;
         // A folder changed by someone else since the run began is refused too.
         let names: Vec<&str> = self.may_write.iter().map(String::as_str).collect();
-        check_dest(&shown, &names)?;
+        check_dest(&shown, &names, &self.reads)?;
         let manifest = serde_json::json!({
             "software": format!("blutrace {}", env!("CARGO_PKG_VERSION")),
             "entries": entries,
@@ -203,8 +211,10 @@ impl Drop for OutputSet {
 
 /// Write one file whole or not at all: `bytes` go to a hidden temporary file beside `path`
 /// (`.NAME.tmp-PID`), synced, then renamed over `path` in one step; on an error the
-/// temporary is removed and `path` is as it was. Errors name `path`.
-pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+/// temporary is removed and `path` is as it was. `path` must not be one of `reads`, the
+/// files the run read ([`check_apart`]). Errors name `path`.
+pub fn write_file<P: AsRef<Path>>(path: &Path, bytes: &[u8], reads: &[P]) -> Result<()> {
+    check_apart(path, reads)?;
     let name = path
         .file_name()
         .with_context(|| format!("{}: not a file name", path.display()))?;
@@ -226,11 +236,13 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-/// Refuse an output folder the set could not replace without losing something: a file
-/// that is not a folder, a folder holding entries blutrace did not write (neither named by
-/// its manifest nor in `may_write` nor a blutrace temporary), the current directory, or a
-/// mount point. A folder that does not exist yet is fine.
-pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
+/// Refuse an output folder the set could not replace without losing something: one that
+/// is or holds a file the run read (`reads`, see [`check_apart`]), a file that is not a
+/// folder, a folder holding entries blutrace did not write (neither named by its manifest
+/// nor in `may_write` nor a blutrace temporary), the current directory, or a mount point.
+/// A folder that does not exist yet is fine.
+pub fn check_dest<P: AsRef<Path>>(dest: &Path, may_write: &[&str], reads: &[P]) -> Result<()> {
+    check_apart(dest, reads)?;
     let shown = dest.display();
     let meta = match fs::metadata(dest) {
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
@@ -272,22 +284,39 @@ pub fn check_dest(dest: &Path, may_write: &[&str]) -> Result<()> {
     Ok(())
 }
 
-/// Refuse an output folder that is, or holds, one of a command's `inputs` (files or
-/// folders it reads, such as the shards of a merge): committing the set would replace the
-/// folder and so delete the input. Paths are compared resolved (symbolic links, `..`), a
-/// folder that does not exist yet by its nearest existing ancestor.
-pub fn check_apart(dest: &Path, inputs: &[&Path]) -> Result<()> {
+/// Refuse an output (a folder, or a file) that is, or holds, one of a command's `inputs`
+/// (the files a scene reads, the shards of a merge): writing the outputs would replace
+/// the output and so delete the input. Paths are compared resolved (symbolic links,
+/// `..`), a path that does not exist yet by its nearest existing ancestor; a hard link
+/// to an input is the input too.
+pub fn check_apart<P: AsRef<Path>>(dest: &Path, inputs: &[P]) -> Result<()> {
     let out = resolved(dest);
-    for input in inputs {
-        if resolved(input).starts_with(&out) {
+    let out_id = file_id(&out);
+    for input in inputs.iter().map(AsRef::as_ref) {
+        let real = resolved(input);
+        if real.starts_with(&out) || (out_id.is_some() && file_id(&real) == out_id) {
             bail!(
-                "{}: is or holds the input {}, which writing the outputs there would delete; choose another output folder",
+                "{}: is or holds {}, an input of this run, which writing the outputs there would delete or replace; choose another output path",
                 dest.display(),
                 input.display()
             );
         }
     }
     Ok(())
+}
+
+/// The device and inode of the file at `p`, if it exists (a hard link shares them).
+fn file_id(p: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        fs::metadata(p).ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = p;
+        None
+    }
 }
 
 /// `p` made absolute with every existing part resolved (the rest appended as written).

@@ -15,13 +15,14 @@ fn listing(dir: &Path) -> Vec<String> {
 }
 
 const NAMES: &[&str] = &["a.json", "b.bin", "run"];
+const NO_READS: &[&Path] = &[];
 
 #[test]
 fn drop_without_commit_leaves_nothing() {
     let t = parent("drop");
     let dest = t.path().join("out");
     {
-        let s = OutputSet::new(&dest, NAMES).unwrap();
+        let s = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
         s.write_bytes("a.json", b"{}").unwrap();
         assert_eq!(listing(t.path()).len(), 1, "the staging folder");
     }
@@ -32,13 +33,13 @@ fn drop_without_commit_leaves_nothing() {
 fn commit_replaces_the_whole_previous_set() {
     let t = parent("commit");
     let dest = t.path().join("out");
-    let s = OutputSet::new(&dest, NAMES).unwrap();
+    let s = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
     s.write_bytes("a.json", b"old").unwrap();
     s.write_bytes("b.bin", b"old").unwrap();
     s.commit().unwrap();
     assert_eq!(listing(&dest), vec![MANIFEST, "a.json", "b.bin"]);
 
-    let s = OutputSet::new(&dest, NAMES).unwrap();
+    let s = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
     s.write_bytes("a.json", b"new").unwrap();
     let run = s.subdir("run").unwrap();
     run.write_bytes("inner.txt", b"x").unwrap();
@@ -84,7 +85,9 @@ fn foreign_entries_are_refused_and_kept() {
     fs::create_dir(&dest).unwrap();
     fs::write(dest.join("a.json"), b"legacy").unwrap();
     fs::write(dest.join("notes.md"), b"mine").unwrap();
-    let err = OutputSet::new(&dest, NAMES).unwrap_err().to_string();
+    let err = OutputSet::new(&dest, NAMES, NO_READS)
+        .unwrap_err()
+        .to_string();
     assert!(
         err.contains("notes.md") && err.contains(&*dest.to_string_lossy()),
         "{err}"
@@ -98,7 +101,7 @@ fn foreign_entries_are_refused_and_kept() {
 
     // Without the foreign file, the legacy folder (no manifest) is replaced.
     fs::remove_file(dest.join("notes.md")).unwrap();
-    let s = OutputSet::new(&dest, NAMES).unwrap();
+    let s = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
     s.write_bytes("b.bin", b"1").unwrap();
     // A file appearing while the run writes is refused at commit too, and survives.
     fs::write(dest.join("late.txt"), b"mine").unwrap();
@@ -109,7 +112,9 @@ fn foreign_entries_are_refused_and_kept() {
 
     let file = t.path().join("file");
     fs::write(&file, b"").unwrap();
-    let err = OutputSet::new(&file, NAMES).unwrap_err().to_string();
+    let err = OutputSet::new(&file, NAMES, NO_READS)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("not a folder"), "{err}");
 }
 
@@ -117,7 +122,7 @@ fn foreign_entries_are_refused_and_kept() {
 fn errors_name_the_final_path() {
     let t = parent("errors");
     let dest = t.path().join("out");
-    let s = OutputSet::new(&dest, NAMES).unwrap();
+    let s = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
     let err = s
         .write_with("a.json", |p| {
             fs::write(p.join("no-such-folder/x"), b"")
@@ -195,7 +200,9 @@ fn a_staging_like_name_inside_the_folder_is_foreign() {
     let dest = t.path().join("out");
     fs::create_dir(&dest).unwrap();
     fs::write(dest.join(".a.json.tmp-1-0"), b"mine").unwrap();
-    let err = OutputSet::new(&dest, NAMES).unwrap_err().to_string();
+    let err = OutputSet::new(&dest, NAMES, NO_READS)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains(".a.json.tmp-1-0"), "{err}");
     assert_eq!(listing(&dest), vec![".a.json.tmp-1-0"]);
 }
@@ -206,8 +213,8 @@ fn a_staging_like_name_inside_the_folder_is_foreign() {
 fn a_folder_created_meanwhile_is_replaced() {
     let t = parent("race");
     let dest = t.path().join("out");
-    let first = OutputSet::new(&dest, NAMES).unwrap();
-    let second = OutputSet::new(&dest, NAMES).unwrap();
+    let first = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
+    let second = OutputSet::new(&dest, NAMES, NO_READS).unwrap();
     first.write_bytes("a.json", b"first").unwrap();
     second.write_bytes("a.json", b"second").unwrap();
     first.commit().unwrap();
@@ -227,18 +234,64 @@ fn a_folder_created_meanwhile_is_replaced() {
 fn a_file_is_written_whole_or_left_as_it_was() {
     let t = parent("file");
     let path = t.path().join("t.bsdf");
-    write_file(&path, b"old").unwrap();
-    write_file(&path, b"new").unwrap();
+    write_file(&path, b"old", NO_READS).unwrap();
+    write_file(&path, b"new", NO_READS).unwrap();
     assert_eq!(fs::read(&path).unwrap(), b"new");
     assert_eq!(listing(t.path()), vec!["t.bsdf"], "no temporary left");
     // A folder in the way: an error naming the path, the folder untouched, no temporary.
     let blocked = t.path().join("dir.bsdf");
     fs::create_dir(&blocked).unwrap();
-    let e = write_file(&blocked, b"x").unwrap_err().to_string();
+    let e = write_file(&blocked, b"x", NO_READS)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("dir.bsdf") && e.starts_with("cannot write"),
         "{e}"
     );
     assert!(blocked.is_dir());
     assert_eq!(listing(t.path()), vec!["dir.bsdf", "t.bsdf"]);
+}
+
+#[test]
+fn a_set_never_replaces_a_folder_holding_what_the_run_read() {
+    let t = parent("inputs");
+    let dest = t.path().join("out");
+    fs::create_dir_all(dest.join("sub")).unwrap();
+    let scene = dest.join("sub/scene.toml");
+    fs::write(&scene, "version = 1").unwrap();
+    // A forged manifest that calls the scene file blutrace's does not make it so.
+    let manifest = serde_json::json!({"entries": ["sub"]});
+    fs::write(dest.join(MANIFEST), manifest.to_string()).unwrap();
+    let err = OutputSet::new(&dest, NAMES, &[&scene])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("out") && err.contains("scene.toml") && err.contains("input"),
+        "{err}"
+    );
+    // Through a symbolic link and `..` too; a folder beside the input is fine.
+    let link = t.path().join("link");
+    std::os::unix::fs::symlink(&dest, &link).unwrap();
+    assert!(OutputSet::new(&link.join("sub/.."), NAMES, &[&scene]).is_err());
+    assert!(OutputSet::new(&t.path().join("other"), NAMES, &[&scene]).is_ok());
+    assert_eq!(fs::read(&scene).unwrap(), b"version = 1");
+}
+
+#[test]
+fn a_file_never_replaces_what_the_run_read() {
+    let t = parent("file-inputs");
+    let table = t.path().join("film.bsdf");
+    fs::write(&table, "measured").unwrap();
+    let err = write_file(&table, b"new", &[&table])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("film.bsdf") && err.contains("input"), "{err}");
+    // A hard link to the input, or a path through `..`, is the input too.
+    let hard = t.path().join("copy.bsdf");
+    fs::hard_link(&table, &hard).unwrap();
+    assert!(write_file(&hard, b"new", &[&table]).is_err());
+    let dotted = t.path().join("x/../film.bsdf");
+    assert!(write_file(&dotted, b"new", &[&table]).is_err());
+    assert_eq!(fs::read(&table).unwrap(), b"measured");
+    write_file(&t.path().join("out.bsdf"), b"new", &[&table]).unwrap();
 }

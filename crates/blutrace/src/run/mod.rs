@@ -460,7 +460,7 @@ impl RunResult {
     /// Write every output into `dir` as one set ([`OutputSet`]): the folder holds the
     /// previous set until the new one is complete; returns the files written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        let set = OutputSet::new(dir, OUTPUT_NAMES)?;
+        let set = OutputSet::new(dir, OUTPUT_NAMES, &self.scene.inputs)?;
         self.write_into(&set)?;
         set.commit()
     }

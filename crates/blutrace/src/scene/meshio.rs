@@ -296,7 +296,7 @@ fn check_buffer_uri(path: &Path, base: &Path, index: usize, uri: &str) -> Result
 }
 
 /// `%XX` escapes of a URI replaced by their bytes (as the glTF loader reads them).
-fn percent_decoded(uri: &str) -> String {
+pub(super) fn percent_decoded(uri: &str) -> String {
     let b = uri.as_bytes();
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;

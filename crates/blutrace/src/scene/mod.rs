@@ -14,6 +14,7 @@ pub mod geometry_file;
 pub mod geometry_report;
 mod gltf_checks;
 mod hash;
+pub mod inputs;
 pub mod key_path;
 mod lamp_placement;
 mod media_checks;
@@ -73,6 +74,8 @@ pub struct Scene {
     pub geometry: Vec<GeometryReport>,
     /// Per medium: its convex solid when the fast path applies (see [`ConvexSolid`]).
     pub convex: Vec<Option<ConvexSolid>>,
+    /// Every file loading read ([`inputs`]): outputs never replace one of them.
+    pub inputs: Vec<PathBuf>,
     /// Hash of the scene file's physics sections and the tables they name.
     file_hash: u64,
     /// The scene file as written ([`Scene::source`]; [`key_path`] reads and edits it).
@@ -200,6 +203,7 @@ impl Scene {
             warnings,
             geometry,
             convex: Vec::new(),
+            inputs: inputs::input_files(file, path),
             file_hash: hash::file_hash(file, path)?,
             source,
         };

@@ -99,7 +99,7 @@ impl LayoutResult {
             .map_err(|e| anyhow::anyhow!("optimized scene does not parse: {e}"))?;
         Scene::from_file(&file, &dir.join("optimized.toml"))
             .context("the optimized scene does not load")?;
-        let staged = OutputSet::new(dir, OUTPUT_NAMES)?;
+        let staged = OutputSet::new(dir, OUTPUT_NAMES, &self.initial_run.scene.inputs)?;
         staged.write_bytes("optimized.toml", toml_text.as_bytes())?;
         staged.write_bytes("history.csv", self.history_csv().as_bytes())?;
         staged.write_bytes("optimize.json", &serde_json::to_vec_pretty(self)?)?;

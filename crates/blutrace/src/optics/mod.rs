@@ -30,6 +30,7 @@ pub mod particles;
 pub mod phase;
 pub mod phong;
 pub mod placement;
+pub mod polarization;
 pub mod sampling;
 pub mod spectrum;
 pub mod surface;

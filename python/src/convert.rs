@@ -36,8 +36,8 @@ pub fn toml_to_py<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, 
     })
 }
 
-/// A Python value as TOML: bool, int, float (numpy scalars too), str, list or tuple,
-/// dict with str keys; anything else is a `TypeError`.
+/// A Python value as TOML: bool, int, float, str, list or tuple, dict with str keys, numpy
+/// arrays and scalars (as their `tolist()`); anything else is a `TypeError`.
 pub fn py_to_toml(v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     if v.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(v.extract()?));
@@ -72,7 +72,18 @@ pub fn py_to_toml(v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         }
         return Ok(toml::Value::Table(t));
     }
-    // numpy scalars and other numbers: integers through __index__, else a float.
+    // numpy arrays and scalars: their Python values (nested lists, bool, int, float).
+    if v.hasattr("tolist")? {
+        let plain = v.call_method0("tolist")?;
+        if plain.hasattr("tolist")? {
+            return Err(PyTypeError::new_err(format!(
+                "cannot write a {} into a scene file (its tolist() is no list or number)",
+                v.get_type().name()?
+            )));
+        }
+        return py_to_toml(&plain);
+    }
+    // Other numbers: integers through __index__, else a float.
     if v.hasattr("__index__")? {
         return Ok(toml::Value::Integer(
             v.call_method0("__index__")?.extract()?,
@@ -164,6 +175,21 @@ pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64) -> PyResult<u64> {
         return Err(bad());
     }
     Ok(n)
+}
+
+/// Argument `name` as a `T`; a value of the wrong type or shape raises the exception it
+/// would (`TypeError`, `ValueError`), its message naming the argument.
+pub fn arg<'a, 'py, T>(v: &'a Bound<'py, PyAny>, name: &str) -> PyResult<T>
+where
+    T: FromPyObject<'a, 'py>,
+    T::Error: Into<PyErr>,
+{
+    v.extract::<T>().map_err(|e| named(v.py(), name, e.into()))
+}
+
+/// `e` with its message prefixed by the argument it is about, its type kept.
+pub fn named(py: Python<'_>, name: &str, e: PyErr) -> PyErr {
+    PyErr::from_type(e.get_type(py), format!("{name}: {}", e.value(py)))
 }
 
 /// One of `choices` (spelling, value), or a `ValueError` listing them.

@@ -19,16 +19,19 @@ mod run;
 mod scene;
 
 use pyo3::create_exception;
+
+// The exceptions are `blutrace.BlutraceError` and `blutrace.SceneError` (their module is the
+// package users import, not the extension module inside it), as tracebacks print them.
 use pyo3::prelude::*;
 
 create_exception!(
-    _native,
+    blutrace,
     BlutraceError,
     pyo3::exceptions::PyException,
     "Base class of blutrace's errors (a run or a write that failed, an internal error)."
 );
 create_exception!(
-    _native,
+    blutrace,
     SceneError,
     BlutraceError,
     "A scene file, or a file it names, is wrong: the message names the file and the field."

@@ -118,6 +118,21 @@ def test_bad_arguments_are_value_errors_naming_them(box, kwargs, says):
         box.trace(**{"photons": 1000, **kwargs})
 
 
+@pytest.mark.parametrize(
+    "kwargs, error, says",
+    [
+        ({"shard": (0,)}, ValueError, "shard"),
+        ({"shard": "0/2"}, ValueError, "shard"),
+        ({"target_error": "small"}, TypeError, "target_error"),
+        ({"max_time": [1.0]}, TypeError, "max_time"),
+    ],
+)
+def test_arguments_of_a_wrong_type_or_shape_are_errors_naming_them(box, kwargs, error, says):
+    with pytest.raises(error) as e:
+        box.trace(**{"photons": 1000, **kwargs})
+    assert says in str(e.value)  # the message itself, not a note pytest's match= also reads
+
+
 def test_photons_may_be_a_whole_float(box):
     assert box.trace(photons=2e4, seed=1).photons == 20_000
 

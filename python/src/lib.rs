@@ -19,11 +19,10 @@ mod run;
 mod scene;
 
 use pyo3::create_exception;
+use pyo3::prelude::*;
 
 // The exceptions are `blutrace.BlutraceError` and `blutrace.SceneError` (their module is the
 // package users import, not the extension module inside it), as tracebacks print them.
-use pyo3::prelude::*;
-
 create_exception!(
     blutrace,
     BlutraceError,

@@ -173,11 +173,10 @@ pub fn optimize_scene(
         Ok(())
     };
     let Waited { stopped, outcome } = wait_detached(py, &o.interrupt, work, drain);
-    match stopped {
-        // Ctrl-C: the search returns the designs traced before it, as the CLI writes them.
-        Some(e) if e.is_instance_of::<PyKeyboardInterrupt>(py) && matches!(outcome, Ok(Ok(_))) => {}
-        Some(e) => return Err(e),
-        None => {}
+    // Ctrl-C: the search returns the designs traced before it, as the CLI writes them.
+    let found = matches!(outcome, Ok(Ok(_)));
+    if let Some(e) = stopped.filter(|e| !(found && e.is_instance_of::<PyKeyboardInterrupt>(py))) {
+        return Err(e);
     }
     drain(py)?;
     let outcome = outcome?.map_err(|e| {

@@ -51,8 +51,7 @@ const TARGET_METRICS: &[(&str, TargetMetric)] = &[
 /// for every element of an array (``sources.*.center.2``: ``get`` gives their one value, or
 /// the list of their values when they differ); ``set`` takes numbers, str, lists, dicts and
 /// numpy arrays and scalars, and loads the scene again from the edited file, so every
-/// check runs. ``check()`` returns what ``blutrace check
-/// --json`` prints.
+/// check runs. ``check()`` returns what ``blutrace check --json`` prints.
 #[pyclass(module = "blutrace", name = "Scene")]
 #[derive(Clone)]
 pub struct Scene {

@@ -86,14 +86,14 @@ def test_sigint_during_an_optimization_returns_the_designs_traced(phone, tmp_pat
     """Ctrl-C once a design is traced: the search stops and returns what it found, as
     `blutrace optimize` writes its set (10,000 iterations would take hours)."""
     heard = []
-    first = threading.Event()
+    first, returned = threading.Event(), threading.Event()
 
     def record(r):
         heard.append(r)
         first.set()
 
     def ctrl_c():
-        if first.wait(120):
+        if first.wait(120) and not returned.is_set():
             os.kill(os.getpid(), signal.SIGINT)
 
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
@@ -107,6 +107,7 @@ def test_sigint_during_an_optimization_returns_the_designs_traced(phone, tmp_pat
             pytest.fail("Ctrl-C raised instead of returning the designs traced")
         elapsed = time.monotonic() - start
     finally:
+        returned.set()
         first.set()
         killer.join()
         signal.signal(signal.SIGINT, previous)

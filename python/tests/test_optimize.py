@@ -49,6 +49,7 @@ def test_a_grid_over_a_key_path_traces_each_value(phone, capsys):
         ({"vary": {"sources.0.center.2": 3}}, ValueError, "pair"),
         ({"photons": 0}, ValueError, "photons"),
         ({"tag": "nope"}, ValueError, "tag: no tag 'nope'"),
+        ({"tag": "led_housing"}, ValueError, "option `tag`: surface 'led_housing' is not"),
         ({"tag": 5}, TypeError, "tag"),
         ({"cells": (4,)}, ValueError, "cells"),
         ({"estimator": 1}, TypeError, "estimator"),

@@ -74,7 +74,11 @@ impl Characterisation {
     }
 
     /// Write the table to ``path`` (a ``.bsdf`` file), whole or not at all.
-    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::path_arg)] path: PathBuf,
+    ) -> PyResult<()> {
         let text = self.to_bsdf();
         py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes()))
             .map_err(run_error)

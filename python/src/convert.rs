@@ -10,6 +10,7 @@ use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::PathBuf;
 
 /// A TOML value as a Python object (tables are dicts, arrays lists, datetimes strings).
 pub fn toml_to_py<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, PyAny>> {
@@ -187,24 +188,50 @@ where
     v.extract::<T>().map_err(|e| named(v.py(), name, e.into()))
 }
 
+/// Argument `path`: a file's path (str or path-like).
+pub fn path_arg(v: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    arg(v, "path")
+}
+
+/// Argument `dir`: a folder's path (str or path-like).
+pub fn dir_arg(v: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    arg(v, "dir")
+}
+
 /// `e` with its message prefixed by the argument it is about, its type kept.
 pub fn named(py: Python<'_>, name: &str, e: PyErr) -> PyErr {
     PyErr::from_type(e.get_type(py), format!("{name}: {}", e.value(py)))
 }
 
 /// One of `choices` (spelling, value), or a `ValueError` listing them.
-pub fn choice<T: Copy>(name: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    choices
-        .iter()
-        .find(|(s, _)| *s == given)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<String> = choices.iter().map(|(s, _)| format!("'{s}'")).collect();
-            PyValueError::new_err(format!(
-                "{name} must be one of {}, got '{given}'",
-                names.join(", ")
-            ))
-        })
+pub fn choice<T: Copy>(name: &str, given: &str, choices: &[(&'static str, T)]) -> PyResult<T> {
+    lookup(name, given, choices).map(|(_, v)| *v)
+}
+
+/// Argument `name`, a str naming one of `choices`, as the table spells it: a `&'static
+/// str`, so a signature keeps its literal default (`from_py_with` of a spelling argument).
+pub fn spelling<T>(
+    v: &Bound<'_, PyAny>,
+    name: &str,
+    choices: &[(&'static str, T)],
+) -> PyResult<&'static str> {
+    let given: String = arg(v, name)?;
+    lookup(name, &given, choices).map(|(s, _)| *s)
+}
+
+/// The entry of `choices` spelled `given`, or a `ValueError` listing them.
+fn lookup<'c, T>(
+    name: &str,
+    given: &str,
+    choices: &'c [(&'static str, T)],
+) -> PyResult<&'c (&'static str, T)> {
+    choices.iter().find(|(s, _)| *s == given).ok_or_else(|| {
+        let names: Vec<String> = choices.iter().map(|(s, _)| format!("'{s}'")).collect();
+        PyValueError::new_err(format!(
+            "{name} must be one of {}, got '{given}'",
+            names.join(", ")
+        ))
+    })
 }
 
 /// A scene error (loading, editing): `SceneError` with the file and field in its message.

@@ -83,7 +83,11 @@ impl Optimization {
 
     /// Write what `blutrace optimize` writes into `dir`, all or nothing; returns the files
     /// and folders written.
-    fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<String>> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::dir_arg)] dir: PathBuf,
+    ) -> PyResult<Vec<String>> {
         let outcome = self.outcome.clone();
         let files = detached(py, || match &*outcome {
             Outcome::Density(r) => r.write(&dir),
@@ -191,7 +195,7 @@ pub fn optimize_scene(
         Outcome::Layout(r) => r.optimized_toml(),
     }
     .map_err(run_error)?;
-    let optimized = Scene::from_toml(py, &toml_text, scene.path.clone())?;
+    let optimized = Scene::from_toml(py, toml_text, scene.path.clone())?;
     Ok(Optimization {
         outcome: Arc::new(outcome),
         scene: optimized,

@@ -2,7 +2,9 @@
 //! and the calls that use it: check, trace, optimize, characterise.
 
 use crate::characterisation::{self, Characterisation};
-use crate::convert::{self, arg, choice, count, py_to_toml, run_error, scene_error, toml_to_py};
+use crate::convert::{
+    self, arg, choice, count, py_to_toml, run_error, scene_error, spelling, toml_to_py,
+};
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
 use crate::progress;
@@ -72,7 +74,10 @@ fn scene_file(p: &Path) -> PathBuf {
 impl Scene {
     /// Load and validate a scene: a scene file or a folder holding `scene.toml`.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
+    fn load(
+        py: Python<'_>,
+        #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
+    ) -> PyResult<Scene> {
         let file = scene_file(&path);
         let scene = detached(py, || RustScene::load(&file))?.map_err(scene_error)?;
         Ok(Scene {
@@ -83,8 +88,12 @@ impl Scene {
     /// A scene from the text of a scene file; its geometry paths are relative to `path`'s
     /// folder (the file it stands for).
     #[staticmethod]
-    pub fn from_toml(py: Python<'_>, text: &str, path: PathBuf) -> PyResult<Scene> {
-        let doc: toml::Value = toml::from_str(text)
+    pub fn from_toml(
+        py: Python<'_>,
+        #[pyo3(from_py_with = text_arg)] text: String,
+        #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
+    ) -> PyResult<Scene> {
+        let doc: toml::Value = toml::from_str(&text)
             .map_err(|e| scene_error(anyhow::anyhow!("{}: {e}", path.display())))?;
         let scene = detached(py, || RustScene::from_source(doc, &path))?.map_err(scene_error)?;
         Ok(Scene {
@@ -136,9 +145,10 @@ impl Scene {
     /// The value at a key path such as `sources.0.center.2`; with `*` for every element of
     /// an array, the one value they all hold, or the list of their values (in order) when
     /// they differ.
-    fn get<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+    fn get<'py>(&self, py: Python<'py>, key: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let key: String = arg(key, "key")?;
         let doc = self.inner.source();
-        let places = key_path::resolve(doc, key).map_err(|e| {
+        let places = key_path::resolve(doc, &key).map_err(|e| {
             PyValueError::new_err(format!("{}: {key}: {e:#}", self.inner.path.display()))
         })?;
         let values: Vec<toml::Value> = places
@@ -153,13 +163,19 @@ impl Scene {
 
     /// Set the value at a key path (every element a `*` names): the scene is loaded again
     /// from the edited file, so every check runs (a `SceneError` leaves it unchanged).
-    fn set(&mut self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let value = py_to_toml(value).map_err(|e| convert::named(py, key, e))?;
-        key_path::resolve(self.inner.source(), key).map_err(|e| {
+    fn set(
+        &mut self,
+        py: Python<'_>,
+        key: &Bound<'_, PyAny>,
+        value: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let key: String = arg(key, "key")?;
+        let value = py_to_toml(value).map_err(|e| convert::named(py, &key, e))?;
+        key_path::resolve(self.inner.source(), &key).map_err(|e| {
             PyValueError::new_err(format!("{}: {key}: {e:#}", self.inner.path.display()))
         })?;
         let scene = self.inner.clone();
-        let edited = detached(py, || scene.with(key, value))?.map_err(scene_error)?;
+        let edited = detached(py, || scene.with(&key, value))?.map_err(scene_error)?;
         self.inner = Arc::new(edited);
         Ok(())
     }
@@ -214,13 +230,13 @@ impl Scene {
         photons: Option<&Bound<'_, PyAny>>,
         seed: Option<&Bound<'_, PyAny>>,
         threads: Option<&Bound<'_, PyAny>>,
-        estimator: &str,
+        #[pyo3(from_py_with = estimator_arg)] estimator: &str,
         target_error: Option<&Bound<'_, PyAny>>,
-        target_metric: &str,
+        #[pyo3(from_py_with = target_metric_arg)] target_metric: &str,
         max_time: Option<&Bound<'_, PyAny>>,
         progress: Option<&Bound<'_, PyAny>>,
         shard: Option<&Bound<'_, PyAny>>,
-        backend: &str,
+        #[pyo3(from_py_with = backend_arg)] backend: &str,
     ) -> PyResult<Run> {
         let target_error: Option<f64> = target_error.map(|v| arg(v, "target_error")).transpose()?;
         let max_time: Option<f64> = max_time.map(|v| arg(v, "max_time")).transpose()?;
@@ -282,11 +298,12 @@ impl Scene {
     fn optimize(
         &self,
         py: Python<'_>,
-        method: Option<&str>,
+        method: Option<&Bound<'_, PyAny>>,
         vary: Option<&Bound<'_, PyDict>>,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Optimization> {
-        optimization::optimize_scene(py, &self.inner, method, vary, options)
+        let method: Option<String> = method.map(|m| arg(m, "method")).transpose()?;
+        optimization::optimize_scene(py, &self.inner, method.as_deref(), vary, options)
     }
 
     /// Characterise a part of the scene into an IS BSDF table, as ``blutrace bsdf`` does:
@@ -305,7 +322,7 @@ impl Scene {
     fn characterise(
         &self,
         py: Python<'_>,
-        tag: &str,
+        tag: &Bound<'_, PyAny>,
         photons: Option<&Bound<'_, PyAny>>,
         aoi: Option<&Bound<'_, PyAny>>,
         rotations: Option<&Bound<'_, PyAny>>,
@@ -315,8 +332,9 @@ impl Scene {
         seed: Option<&Bound<'_, PyAny>>,
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Characterisation> {
+        let tag: String = arg(tag, "tag")?;
         let args = characterisation::Args {
-            tag,
+            tag: &tag,
             photons,
             aoi: aoi.map_or_else(
                 || Ok(blutrace::characterise::DEFAULT_AOI_DEG.to_vec()),
@@ -350,6 +368,26 @@ impl Scene {
             self.inner.path.display().to_string()
         )
     }
+}
+
+/// Argument `text` of `from_toml`: a scene file's text.
+fn text_arg(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    arg(v, "text")
+}
+
+/// Argument `estimator`: one of [`ESTIMATORS`].
+fn estimator_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "estimator", ESTIMATORS)
+}
+
+/// Argument `target_metric`: one of [`TARGET_METRICS`].
+fn target_metric_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "target_metric", TARGET_METRICS)
+}
+
+/// Argument `backend`: one of [`BACKENDS`].
+fn backend_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "backend", BACKENDS)
 }
 
 /// `shard=(k, m)` checked: 0 <= k < m <= MAX_SHARDS.

@@ -147,3 +147,29 @@ def test_check_is_what_check_json_prints(cli, box):
     printed = json.loads(run_cli(cli, "check", box.path, "--json").stdout)
     assert mine == printed
     assert mine["scene"] == "bench-box" and mine["tally_bytes"] > 0
+
+
+@pytest.mark.parametrize(
+    "call, says",
+    [
+        (lambda box: bt.Scene.load(5), "path"),
+        (lambda box: bt.Scene.from_toml(5, "scene.toml"), "text"),
+        (lambda box: bt.Scene.from_toml(box.to_toml(), 5), "path"),
+        (lambda box: box.get(5), "key"),
+        (lambda box: box.copy().set(5, 1.0), "key"),
+        (lambda box: box.trace(photons=1000, estimator=None), "estimator"),
+        (lambda box: box.trace(photons=1000, target_metric=1), "target_metric"),
+        (lambda box: box.trace(photons=1000, backend=1), "backend"),
+        (lambda box: box.optimize(method=1), "method"),
+        (lambda box: box.characterise(5), "tag"),
+        (lambda box: box.trace(photons=1000).write(5), "dir"),
+        (lambda box: bt.merge(5), "runs"),
+        (lambda box: bt.merge([box.trace(photons=1000, shard=(0, 1))], partial="yes"), "partial"),
+        (lambda box: bt.read_exr(5), "path"),
+    ],
+    ids=lambda x: x if isinstance(x, str) else "",
+)
+def test_an_argument_of_a_wrong_type_is_a_type_error_naming_it(box, call, says):
+    with pytest.raises(TypeError) as e:
+        call(box)
+    assert str(e.value).startswith(f"{says}: "), str(e.value)

@@ -299,11 +299,13 @@ impl Scene {
         &self,
         py: Python<'_>,
         method: Option<&Bound<'_, PyAny>>,
-        vary: Option<&Bound<'_, PyDict>>,
+        vary: Option<&Bound<'_, PyAny>>,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Optimization> {
         let method: Option<String> = method.map(|m| arg(m, "method")).transpose()?;
-        optimization::optimize_scene(py, &self.inner, method.as_deref(), vary, options)
+        let vary: Option<Bound<'_, PyDict>> = vary.map(|v| arg(v, "vary")).transpose()?;
+        let (method, vary) = (method.as_deref(), vary.as_ref());
+        optimization::optimize_scene(py, &self.inner, method, vary, options)
     }
 
     /// Characterise a part of the scene into an IS BSDF table, as ``blutrace bsdf`` does:

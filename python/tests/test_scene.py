@@ -161,13 +161,14 @@ def test_check_is_what_check_json_prints(cli, box):
         (lambda box: box.trace(photons=1000, target_metric=1), "target_metric"),
         (lambda box: box.trace(photons=1000, backend=1), "backend"),
         (lambda box: box.optimize(method=1), "method"),
+        (lambda box: box.optimize(vary=[("sources.0.center.2", (0.1, 0.3))]), "vary"),
         (lambda box: box.characterise(5), "tag"),
         (lambda box: box.trace(photons=1000).write(5), "dir"),
         (lambda box: bt.merge(5), "runs"),
         (lambda box: bt.merge([box.trace(photons=1000, shard=(0, 1))], partial="yes"), "partial"),
         (lambda box: bt.read_exr(5), "path"),
     ],
-    ids=lambda x: x if isinstance(x, str) else "",
+    ids=lambda x: x if isinstance(x, str) else "call",
 )
 def test_an_argument_of_a_wrong_type_is_a_type_error_naming_it(box, call, says):
     with pytest.raises(TypeError) as e:

@@ -316,8 +316,9 @@ impl Scene {
     /// ``radial_step`` and ``azimuth_step`` the table's cells (2 and 10 degrees),
     /// ``u_axis`` the direction of rotation 0 on the face, ``seed`` (1); ``progress`` as
     /// ``trace``'s, over the photons of all incidences (reported an incidence at a time).
-    /// Releases the GIL; Ctrl-C stops it before the next incidence. A bad argument or a
-    /// part that is not one flat face raises ``ValueError``.
+    /// Releases the GIL; Ctrl-C stops it before the next incidence. A bad argument (an
+    /// unknown tag included) or a part that is not one flat face raises ``ValueError``, an
+    /// argument of a wrong type ``TypeError``.
     #[pyo3(signature = (tag, photons=None, aoi=None, rotations=None, radial_step=2.0,
         azimuth_step=10.0, u_axis=None, seed=None, progress=None))]
     #[allow(clippy::too_many_arguments)]

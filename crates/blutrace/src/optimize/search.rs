@@ -30,14 +30,13 @@ fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
     };
     match tag {
         Some(t) => {
-            let i = scene
-                .tags
-                .iter()
-                .position(|x| x == t)
-                .with_context(|| format!("{}: no tag '{t}'", scene.path.display()))?;
+            let i =
+                scene.tags.iter().position(|x| x == t).with_context(|| {
+                    format!("{}: option `tag`: no tag '{t}'", scene.path.display())
+                })?;
             if !dots.contains(&i) {
                 bail!(
-                    "{}: surface '{t}' is not model = \"dots\" (dots surfaces: {})",
+                    "{}: option `tag`: surface '{t}' is not model = \"dots\" (dots surfaces: {})",
                     scene.path.display(),
                     names()
                 );

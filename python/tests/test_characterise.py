@@ -66,6 +66,17 @@ def test_the_written_table_is_a_bsdf_table_face(sheet, tmp_path):
     assert abs(a - b) < 4 * np.sqrt(2 * a * (1 - a) / 200_000), (a, b)
 
 
+def test_nothing_is_written_over_a_file_the_scene_reads(sheet, tmp_path):
+    c = sheet.characterise("sheet", photons=1000, aoi=[0])
+    mesh = tmp_path / "sheet.obj"
+    with pytest.raises(bt.BlutraceError, match="an input of this run"):
+        c.write(mesh)
+    run = sheet.trace(photons=1000, seed=1)
+    with pytest.raises(bt.BlutraceError, match="sheet.obj"):
+        run.write(tmp_path)
+    assert mesh.read_text() == OBJ
+
+
 @pytest.mark.parametrize(
     "kwargs, says",
     [

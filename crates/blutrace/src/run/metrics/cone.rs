@@ -60,11 +60,15 @@ pub fn luminance_cone_map(scene: &Scene, t: &Tally) -> Option<Map> {
     Some(map_of(scene, g, t.ledger.photons, efficacy))
 }
 
-/// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity.
+/// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity. When no
+/// photon fell within the cone (`photons_in_cone` 0) the map measured nothing: every
+/// estimate is NaN (`null`), not 0 ± 0 cd/m².
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LuminanceMapSummary {
     /// Half-angle of the cone (degrees).
     pub cone_deg: f64,
+    /// Photons that left the target within the cone (over every bin).
+    pub photons_in_cone: u64,
     /// Mean luminance over the target (cd/m²).
     pub mean_cd_m2: Estimate,
     /// RMS deviation over mean of the map.
@@ -107,12 +111,20 @@ pub fn luminance_map_summary(
         })
         .collect();
     let values = own.values();
-    let est = |m: Metric| Estimate {
-        value: values[m],
-        stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
+    let photons_in_cone: u64 = grid.bins.iter().map(|b| b.hits).sum();
+    let est = |m: Metric| match photons_in_cone {
+        0 => Estimate {
+            value: f64::NAN,
+            stderr: f64::NAN,
+        },
+        _ => Estimate {
+            value: values[m],
+            stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
+        },
     };
     Some(LuminanceMapSummary {
         cone_deg: scene.detector.luminance_cone_deg,
+        photons_in_cone,
         mean_cd_m2: est(Metric::Mean),
         cv: est(Metric::Cv),
         cv_noise_floor: own.cv_noise_floor,

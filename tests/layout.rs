@@ -525,3 +525,33 @@ fn a_design_without_light_is_never_the_best() {
         );
     }
 }
+
+/// Weighting the objective changes no design the simplex asks for (audit 3, item 2): a
+/// point outside the bounds ranks after every traced design whatever the objective's
+/// scale, where a fixed penalty of 1000 ranked it first under `cv=1e6`. The LED's best
+/// height lies at the range's lower end, so the simplex steps outside it.
+#[test]
+fn weighting_the_objective_leaves_the_layout_search_unchanged() {
+    let dir = led_under_target("layout-weight", 0.0);
+    let scene = load(&dir);
+    let search = |objective: &str| {
+        let mut o = options(&["sources.0.center.2=-10..0"], Method::NelderMead);
+        o.photons = 4_000;
+        o.max_iter = 15;
+        o.objective = objective.parse().unwrap();
+        run(&scene, &o)
+    };
+    let (a, b) = (search("cv=1"), search("cv=1e6"));
+    let asked = |r: &LayoutResult| -> Vec<(Vec<f64>, bool)> {
+        r.history
+            .iter()
+            .map(|h| (h.values.clone(), h.result.is_some()))
+            .collect()
+    };
+    assert!(
+        a.history.iter().any(|h| h.result.is_none()),
+        "the simplex never left the bounds"
+    );
+    assert_eq!(asked(&a), asked(&b));
+    assert_eq!(a.variables[0].final_value, b.variables[0].final_value);
+}

@@ -141,3 +141,42 @@ fn write_rays(scene: &Path) {
     std::fs::create_dir_all(&rays).unwrap();
     std::fs::write(rays.join("led.rays"), cone_rays()).unwrap();
 }
+
+/// A file the written scene would name but that is gone is found before the search, not
+/// after it: the search stops at once, naming the key.
+#[test]
+fn a_missing_file_stops_the_search_before_it_starts() {
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.8\n{}\
+         [detector]\norigin = [-100.0, -100.0, 10.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [200.0, 200.0]\nbins = [4, 4]\nangular_bins = [3, 4]\n",
+        ray_source("rotate_deg = [180.0, 0.0, 0.0]\ntranslate = [0.0, 0.0, 5.0]")
+    );
+    let obj =
+        "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
+    let dir = write_scene(
+        "optimized-gone",
+        &toml,
+        &[("sheet.obj", obj), ("led.csv", SPECTRUM)],
+    );
+    write_rays(&dir);
+    let scene = load(&dir);
+    std::fs::remove_file(dir.parent().unwrap().join("rays/led.rays")).unwrap();
+    let opts = OptimizeOptions {
+        method: Method::Grid,
+        vary: vec!["sources.0.translate.2=3..6".parse().unwrap()],
+        grid_points: 2,
+        photons: 5_000,
+        verify_photons: 0,
+        threads: Some(1),
+        ..OptimizeOptions::default()
+    };
+    let mut traced = 0;
+    let e = optimize_layout(&scene, &opts, &mut |_, _| traced += 1).unwrap_err();
+    let e = format!("{e:#}");
+    assert!(
+        e.contains("sources[0].file") && e.contains("led.rays"),
+        "{e}"
+    );
+    assert_eq!(traced, 0, "designs were traced before the error");
+}

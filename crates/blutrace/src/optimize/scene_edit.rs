@@ -184,6 +184,59 @@ mod tests {
         assert!(n > 0, "no scenes under {}", scenes.display());
     }
 
+    /// Ray, spectrum and BSDF files, an LED's table and a lamp body's table: every path
+    /// key is made absolute wherever it stands, strings that are not paths are left, and
+    /// a missing file is named by its key.
+    #[test]
+    fn every_path_key_is_made_absolute_wherever_it_stands() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = [
+            "a.obj", "r.rays", "s.csv", "f.bsdf", "b.bsdf", "k.bsdf", "led.ies",
+        ];
+        for f in files {
+            std::fs::write(dir.path().join(f), "").unwrap();
+        }
+        let mut doc: toml::Value = toml::from_str(
+            "name = \"file\"\n[[geometry]]\nfile = \"a.obj\"\n\
+             [surfaces.s]\nfile = [\"f.bsdf\", \"b.bsdf\"]\nback_file = \"k.bsdf\"\n\
+             [[sources]]\nfile = \"r.rays\"\nspectrum = { file = \"s.csv\" }\n\
+             body = { model = \"bsdf_table\", file = \"f.bsdf\" }\n\
+             [[sources]]\nintensity_file = \"led.ies\"\nspectrum = \"cie-led-b5\"\n",
+        )
+        .unwrap();
+        let path = dir.path().join("scene.toml");
+        absolute_paths(&mut doc, "", &path, dir.path()).unwrap();
+        let root = dir.path().canonicalize().unwrap();
+        let abs = |f: &str| root.join(f).to_string_lossy().into_owned();
+        let s = &doc["sources"][0];
+        assert_eq!(doc["geometry"][0]["file"].as_str(), Some(&*abs("a.obj")));
+        assert_eq!(
+            doc["surfaces"]["s"]["file"][1].as_str(),
+            Some(&*abs("b.bsdf"))
+        );
+        assert_eq!(
+            doc["surfaces"]["s"]["back_file"].as_str(),
+            Some(&*abs("k.bsdf"))
+        );
+        assert_eq!(s["file"].as_str(), Some(&*abs("r.rays")));
+        assert_eq!(s["spectrum"]["file"].as_str(), Some(&*abs("s.csv")));
+        assert_eq!(s["body"]["file"].as_str(), Some(&*abs("f.bsdf")));
+        let led = &doc["sources"][1];
+        assert_eq!(led["intensity_file"].as_str(), Some(&*abs("led.ies")));
+        assert_eq!(led["spectrum"].as_str(), Some("cie-led-b5"));
+        assert_eq!(doc["name"].as_str(), Some("file"));
+        let mut gone: toml::Value =
+            toml::from_str("[[sources]]\nspectrum = { file = \"gone.csv\" }\n").unwrap();
+        let e = format!(
+            "{:#}",
+            absolute_paths(&mut gone, "", &path, dir.path()).unwrap_err()
+        );
+        assert!(
+            e.contains("sources[0].spectrum.file") && e.contains("gone.csv"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn the_density_is_replaced_and_the_paths_made_absolute() {
         let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))

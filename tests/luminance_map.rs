@@ -145,6 +145,11 @@ fn the_command_lines_cone_replaces_the_scenes_and_is_checked() {
     let m = &s["luminance_map"];
     assert_eq!(m["photons_in_cone"], 0, "{m}");
     assert!(m["mean_cd_m2"]["value"].is_null() && m["mean_cd_m2"]["stderr"].is_null());
+    // How many it would need, from the photons near the normal: more than a trillion
+    // (the cone holds 3e-10 of the light's projected solid angle).
+    let needed = m["photons_needed"].as_f64().unwrap();
+    assert!(needed > 1e12 && needed.is_finite(), "{m}");
+    assert!(said.contains("a noise floor of 0.1 needs about"), "{said}");
     for (extra, says) in [
         (
             &["--luminance-cone-deg", "95"][..],

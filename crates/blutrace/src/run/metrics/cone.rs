@@ -75,6 +75,9 @@ pub struct LuminanceMapSummary {
     pub cv: Estimate,
     /// The cv a perfectly uniform panel would show from noise alone.
     pub cv_noise_floor: f64,
+    /// About how many photons a noise floor of 0.1 needs ([`photons_needed`]; NaN: no
+    /// estimate).
+    pub photons_needed: f64,
     /// `sqrt(max(cv^2 - floor^2, 0))`.
     pub cv_debiased: Estimate,
     /// Smallest bin over largest.
@@ -128,9 +131,34 @@ pub fn luminance_map_summary(
         mean_cd_m2: est(Metric::Mean),
         cv: est(Metric::Cv),
         cv_noise_floor: own.cv_noise_floor,
+        photons_needed: photons_needed(scene, total, photons_in_cone, own.cv_noise_floor),
         cv_debiased: est(Metric::CvDebiased),
         min_over_max: est(Metric::MinOverMax),
         nine_point_min_over_max: est(Metric::NinePoint),
         thirteen_point_min_over_max: est(Metric::ThirteenPoint),
     })
+}
+
+/// About how many photons the luminance map needs for a noise floor of 0.1 (NaN: no
+/// estimate). The floor falls as 1/sqrt(photons), so a map with photons in its cone
+/// (`in_cone`) and floor `floor` needs `(floor / 0.1)^2` times as many. An empty map is
+/// estimated from the angular grid's first theta row: the cone holds its photons in the
+/// ratio of their projected solid angles, `sin^2(cone) / sin^2(row)` (exact for light of
+/// uniform radiance near the normal), and a floor of 0.1 takes about 100 photons a bin
+/// (Poisson: 1/sqrt(100)).
+pub fn photons_needed(scene: &Scene, t: &Tally, in_cone: u64, floor: f64) -> f64 {
+    let n = t.ledger.photons as f64;
+    if in_cone > 0 {
+        return n * (floor / 0.1).powi(2);
+    }
+    let d = &scene.detector;
+    let [nt, np] = d.angular_bins;
+    let row: u64 = (0..np).map(|ip| t.angular.bins[ip * nt].hits).sum();
+    let sin2 = |deg: f64| deg.to_radians().sin().powi(2);
+    let per_photon = row as f64 / n * sin2(d.luminance_cone_deg) / sin2(90.0 / nt as f64);
+    let bins = (d.bins[0] * d.bins[1]) as f64;
+    match per_photon > 0.0 {
+        true => 100.0 * bins / per_photon,
+        false => f64::NAN,
+    }
 }

@@ -116,7 +116,7 @@ impl DetectorSpec {
 /// angle. A hundredth of the narrowest spot meter's angle (0.1 degrees, Topcon BM-7).
 pub const MIN_CONE_DEG: f64 = 0.001;
 
-/// A luminance cone's half-angle (degrees) must lie within [[`MIN_CONE_DEG`], 90].
+/// A luminance cone's half-angle (degrees) must lie within [`MIN_CONE_DEG`] ..= 90.
 fn check_cone(deg: f64) -> Result<(), String> {
     match (MIN_CONE_DEG..=90.0).contains(&deg) {
         true => Ok(()),

@@ -40,7 +40,8 @@ pub struct BsdfArgs {
     #[arg(long, default_value_t = 10.0)]
     azimuth_step: f64,
     /// The direction of sample rotation 0 on the face, as `X,Y,Z` or `X Y Z` (default: x,
-    /// or y on faces facing x).
+    /// or y on faces facing x); a negative X in the first form follows `=`:
+    /// `--u-axis=-1,0,0`.
     #[arg(
         long,
         value_delimiter = ',',

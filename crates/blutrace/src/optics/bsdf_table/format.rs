@@ -566,7 +566,7 @@ mod tests {
     }
 
     /// `GOOD` with `n` azimuths and `n` radials (increasing, within range) but its two
-    /// blocks of 3 x 2 values: the counts claim `n * n` values a block.
+    /// blocks of 2 x 3 values: the counts claim `n * n` values a block.
     fn huge_grid(n: usize) -> String {
         let list = |max: f64| {
             (0..n)
@@ -586,11 +586,12 @@ mod tests {
 
     #[test]
     fn counts_the_file_cannot_hold_are_refused_before_allocating() {
-        // 100000 x 100000 values a block (80 GB) declared in a 1.3 MB file: an error
-        // naming the counts, not an aborted allocation.
-        let e = err(&huge_grid(100_000));
+        // 3000 x 3000 values a block declared in a 50 KB file: an error naming the counts
+        // before the block is allocated (at 100000 x 100000, 80 GB, the allocation
+        // aborted; this size fails safely without the check, at the end of the file).
+        let e = err(&huge_grid(3000));
         assert!(
-            e.starts_with("t.bsdf: line 16: a block of ScatterAzimuth 100000 x ScatterRadial 100000 values needs 10000000002 numbers, but the file holds only 17 more"),
+            e.starts_with("t.bsdf: line 16: a block of ScatterAzimuth 3000 x ScatterRadial 3000 values needs 9000002 numbers, but the file holds only 17 more"),
             "{e}"
         );
         // A list longer than the file.

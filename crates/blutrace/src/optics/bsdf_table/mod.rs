@@ -190,20 +190,6 @@ impl Table {
         }
     }
 
-    /// The rotations (radians) where the nearest node changes: half-way between
-    /// neighbouring nodes, round the circle.
-    fn rotation_edges(&self) -> impl Iterator<Item = f64> + '_ {
-        let n = self.rotations.len();
-        (0..n).map(move |i| {
-            let next = if i + 1 < n {
-                self.rotations[i + 1]
-            } else {
-                self.rotations[0] + TAU
-            };
-            (0.5 * (self.rotations[i] + next)).rem_euclid(TAU)
-        })
-    }
-
     /// The largest TIS over the angles of incidence of each sample rotation.
     fn max_tis(&self) -> Vec<f64> {
         let n = self.aoi.len();
@@ -534,33 +520,34 @@ fn check_sum(
 const TIS_SUM_TOLERANCE: f64 = 1e-9;
 
 /// Sample rotations (radians) that meet every pair of nodes two tables read together:
-/// both tables' nodes and half-way rotations, and the middle of each interval between
-/// them (the pair is the same across an interval).
+/// both tables' nodes and the rotations where either's nearest node changes (half-way
+/// between its nodes), and the middle of each interval between these (the pair is the
+/// same across an interval).
 fn rotation_probes(a: &Table, b: &Table) -> Vec<f64> {
     let mut edges: Vec<f64> = a
         .rotations
         .iter()
         .chain(&b.rotations)
         .copied()
-        .chain(a.rotation_edges())
-        .chain(b.rotation_edges())
+        .chain(half_way_round(&a.rotations))
+        .chain(half_way_round(&b.rotations))
         .collect();
     edges.sort_by(f64::total_cmp);
     edges.dedup();
-    let n = edges.len();
-    let middles: Vec<f64> = (0..n)
-        .map(|i| {
-            let next = if i + 1 < n {
-                edges[i + 1]
-            } else {
-                edges[0] + TAU
-            };
-            (0.5 * (edges[i] + next)).rem_euclid(TAU)
-        })
-        .collect();
+    let middles: Vec<f64> = half_way_round(&edges).collect();
     edges.extend(middles);
     edges.sort_by(f64::total_cmp);
     edges
+}
+
+/// The angles half-way between neighbours of the increasing angles `v` (radians, in
+/// [0, 2 pi)), round the circle: the last one's is half-way to the first plus 2 pi.
+fn half_way_round(v: &[f64]) -> impl Iterator<Item = f64> + '_ {
+    let n = v.len();
+    (0..n).map(move |i| {
+        let next = if i + 1 < n { v[i + 1] } else { v[0] + TAU };
+        (0.5 * (v[i] + next)).rem_euclid(TAU)
+    })
 }
 
 #[cfg(test)]

@@ -42,9 +42,9 @@ use std::f64::consts::{PI, TAU};
 /// checks: each cell it can draw has directions above the surface).
 pub const MAX_TRIES: usize = 10_000;
 
-/// The least share of a block's draws that may land above the surface ([`BlockSampler::
-/// kept`]): a block whose values lie (almost) all below the surface would take hundreds
-/// of draws a photon, and is refused when the table is read instead.
+/// The least share of a block's draws that may land above the surface
+/// ([`BlockSampler::kept`]): a block whose values lie (almost) all below the surface
+/// would take hundreds of draws a photon, and is refused when the table is read instead.
 pub const MIN_KEPT: f64 = 0.01;
 
 /// How a photon meets a face: the angles that pick the table's block and the frame its

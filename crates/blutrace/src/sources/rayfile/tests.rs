@@ -543,3 +543,39 @@ fn the_summary_names_the_tables_per_ray() {
         "{e}"
     );
 }
+
+/// A spectral table's scale is free (TM-25-13 4.7.4: relative power): the file's table,
+/// and its tables per ray, at 1e300 or 1e-300 give the colour and the draws of the same
+/// tables at 1.
+#[test]
+fn spectral_tables_at_any_scale_draw_the_same_wavelengths() {
+    let scaled = |rows: &[[f64; 2]], s: f64| -> Vec<[f64; 2]> {
+        rows.iter().map(|&[nm, v]| [nm, v * s]).collect()
+    };
+    let looks = |set: &RaySet| {
+        let e = set.emission_spectrum().unwrap().unwrap();
+        let mut draws = vec![e.xyz_per_w().xy().unwrap().x, e.efficacy_lm_per_w()];
+        for t in set.table_spectra().unwrap() {
+            draws.extend((0..100).map(|k| t.sample((k as f64 + 0.5) / 100.0)));
+        }
+        draws
+    };
+    let at = |s: f64| {
+        let mut one = sample_set();
+        one.nm.clear();
+        one.spectrum = FileSpectrum::Table(scaled(&blue_and_yellow()[1], s));
+        let mut many = tables_set();
+        if let FileSpectrum::Tables(t) = &mut many.spectrum {
+            t.iter_mut().for_each(|rows| *rows = scaled(rows, s));
+        }
+        [looks(&one), looks(&many)]
+    };
+    let want = at(1.0);
+    for s in [1e300, 1e-300] {
+        for (got, want) in at(s).iter().zip(&want) {
+            for (g, w) in got.iter().zip(want) {
+                assert!((g - w).abs() <= 1e-12 * w.abs(), "scale {s:e}: {g} against {w}");
+            }
+        }
+    }
+}

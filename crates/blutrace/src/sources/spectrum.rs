@@ -145,8 +145,8 @@ impl SpectrumSpec {
 /// Rows `nm, value` of a spectrum file.
 fn read_file(ctx: &Ctx, field: &str, file: &Path) -> Result<Spectrum> {
     let path = ctx.0.parent().unwrap_or(Path::new(".")).join(file);
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| ctx.err(field, format!("cannot read {}: {e}", path.display())))?;
+    let text = crate::input_file::read_text(&path, "spectrum file")
+        .map_err(|e| ctx.err(field, format!("{e:#}")))?;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();

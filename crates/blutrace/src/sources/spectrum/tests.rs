@@ -122,6 +122,29 @@ fn spectrum_files_read_with_a_header_and_comments() {
     );
 }
 
+/// A spectrum file is read as every input is: a FIFO or a link to /dev/zero is refused
+/// at once, naming the field and the file (not a read that blocks or fills memory).
+#[test]
+fn spectrum_files_must_be_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let c = Ctx(&scene);
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.csv")).unwrap();
+    let fifo = dir.path().join("fifo.csv");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.unwrap().success());
+    for name in ["zero.csv", "fifo.csv"] {
+        let s = spec(&format!("{{ file = \"{name}\" }}")).unwrap();
+        let e = format!("{:#}", s.build(&c, "sources[2].spectrum").unwrap_err());
+        assert!(
+            e.contains("scene.toml: sources[2].spectrum")
+                && e.contains(name)
+                && e.contains("cannot read spectrum file: not a regular file"),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn bad_spectra_are_named() {
     let e = build("\"cie-led-b9\"").unwrap_err();

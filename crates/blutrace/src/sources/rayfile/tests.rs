@@ -579,3 +579,31 @@ fn spectral_tables_at_any_scale_draw_the_same_wavelengths() {
         }
     }
 }
+
+/// Rays whose flux sums to 3.4e39 W, with no `power_w`, would be the source's power: the
+/// error names the entry's file field and the file, and says the rays' flux is too large
+/// (not a `power_w` the scene never set). Given `power_w`, the flux only weighs the rays.
+#[test]
+fn rays_too_bright_for_a_source_are_named_at_the_file() {
+    let mut set = sample_set();
+    set.nm.clear();
+    set.spectrum = FileSpectrum::None;
+    set.rays = (0..11)
+        .map(|_| ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], 3.1e38))
+        .collect();
+    let (dir, _) = written(&set);
+    let scene = dir.path().join("scene.toml");
+    let spec = |extra: &str| -> RayFileSpec {
+        toml::from_str(&format!("file = \"led.TM25RAY\"\n{extra}")).unwrap()
+    };
+    let e = format!(
+        "{:#}",
+        spec("").emitter(&Ctx(&scene), "sources[1]").unwrap_err()
+    );
+    assert!(
+        e.contains("scene.toml: sources[1].file: led.TM25RAY: the rays' total flux is 3.41e39 W, too large"),
+        "{e}"
+    );
+    let e = spec("power_w = 0.5").emitter(&Ctx(&scene), "sources[1]").unwrap();
+    assert!((e.probability(3) - 1.0 / 11.0).abs() < 1e-6);
+}

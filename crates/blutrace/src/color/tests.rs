@@ -263,7 +263,12 @@ fn ratios_of_a_spectrum_do_not_depend_on_its_scale() {
     for scale in [1e306, 1e-310] {
         let rows: Vec<[f64; 2]> = d65.rows().map(|[nm, v]| [nm, v / peak * scale]).collect();
         let s = Spectrum::from_rows(&rows).unwrap();
-        assert_near("efficacy", luminous_efficacy(&s).unwrap(), lm_w, 1e-12 * lm_w);
+        assert_near(
+            "efficacy",
+            luminous_efficacy(&s).unwrap(),
+            lm_w,
+            1e-12 * lm_w,
+        );
         let got = Xyz::relative(&s).unwrap();
         assert_near("X", got.x, xyz.x, 1e-10);
         assert_near("Z", got.z, xyz.z, 1e-10);

@@ -84,7 +84,10 @@ impl PhaseTable {
             return Err("the values are all 0".into());
         }
         let mut t = PhaseTable {
-            knots: rows.iter().map(|[a, v]| (a.to_radians(), v / peak)).collect(),
+            knots: rows
+                .iter()
+                .map(|[a, v]| (a.to_radians(), v / peak))
+                .collect(),
             cdf: Vec::with_capacity(TABLE_CELLS + 1),
             mean_cosine: 0.0,
         };

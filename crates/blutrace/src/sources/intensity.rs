@@ -650,8 +650,14 @@ mod tests {
         };
         close(&ies(&candela("e306")), "candela 1e306");
         close(&ies(&candela("e-300")), "candela 1e-300");
-        close(&ies(&IES.replace(" 1.0 4 3 ", " 1e306 4 3 ")), "multiplier 1e306");
-        close(&ies(&IES.replace(" 1.0 4 3 ", " 1e-300 4 3 ")), "multiplier 1e-300");
+        close(
+            &ies(&IES.replace(" 1.0 4 3 ", " 1e306 4 3 ")),
+            "multiplier 1e306",
+        );
+        close(
+            &ies(&IES.replace(" 1.0 4 3 ", " 1e-300 4 3 ")),
+            "multiplier 1e-300",
+        );
         let csv = |s: &str| {
             let text = format!("0,2{s}\n30,3{s}\n60,1{s}\n90,0\n");
             IntensityProfile::parse_csv(&text, Path::new("x.csv")).unwrap()

@@ -55,8 +55,8 @@ use crate::color::Spectrum;
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::optics::medium::air;
 use crate::scene::geometry_file::{Units, affine_matrix, rotation_deg};
-use crate::spec_check::{Ctx, short};
 use crate::sources::MAX_TOTAL_POWER_W;
+use crate::spec_check::{Ctx, short};
 use anyhow::{Result, bail};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
@@ -440,11 +440,11 @@ impl RayFileSpec {
         let total = set.total_flux();
         let why = if !(total > 0.0 && total.is_finite()) {
             "nothing to emit"
-        } else if self.power_w.is_none()
-            && set.unit == FluxUnit::Watt
-            && total > MAX_TOTAL_POWER_W
+        } else if self.power_w.is_none() && set.unit == FluxUnit::Watt && total > MAX_TOTAL_POWER_W
         {
-            &format!("too large for the source's power (at most {MAX_TOTAL_POWER_W:e} W): give power_w, and the rays' flux only weighs them against each other")
+            &format!(
+                "too large for the source's power (at most {MAX_TOTAL_POWER_W:e} W): give power_w, and the rays' flux only weighs them against each other"
+            )
         } else {
             return Ok(());
         };

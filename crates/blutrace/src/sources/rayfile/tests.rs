@@ -574,7 +574,10 @@ fn spectral_tables_at_any_scale_draw_the_same_wavelengths() {
     for s in [1e300, 1e-300] {
         for (got, want) in at(s).iter().zip(&want) {
             for (g, w) in got.iter().zip(want) {
-                assert!((g - w).abs() <= 1e-12 * w.abs(), "scale {s:e}: {g} against {w}");
+                assert!(
+                    (g - w).abs() <= 1e-12 * w.abs(),
+                    "scale {s:e}: {g} against {w}"
+                );
             }
         }
     }
@@ -601,9 +604,13 @@ fn rays_too_bright_for_a_source_are_named_at_the_file() {
         spec("").emitter(&Ctx(&scene), "sources[1]").unwrap_err()
     );
     assert!(
-        e.contains("scene.toml: sources[1].file: led.TM25RAY: the rays' total flux is 3.41e39 W, too large"),
+        e.contains(
+            "scene.toml: sources[1].file: led.TM25RAY: the rays' total flux is 3.41e39 W, too large"
+        ),
         "{e}"
     );
-    let e = spec("power_w = 0.5").emitter(&Ctx(&scene), "sources[1]").unwrap();
+    let e = spec("power_w = 0.5")
+        .emitter(&Ctx(&scene), "sources[1]")
+        .unwrap();
     assert!((e.probability(3) - 1.0 / 11.0).abs() < 1e-6);
 }

@@ -198,7 +198,9 @@ fn a_spectrum_scale_changes_neither_colour_nor_wavelengths() {
         let scaled: Vec<[f64; 2]> = rows.iter().map(|&[nm, v]| [nm, v * scale]).collect();
         let e = EmissionSpectrum::new(&Spectrum::from_rows(&scaled).unwrap()).unwrap();
         let xy = e.xyz_per_w().xy().unwrap();
-        let draws: Vec<f64> = (0..1000).map(|k| e.sample((k as f64 + 0.5) / 1000.0)).collect();
+        let draws: Vec<f64> = (0..1000)
+            .map(|k| e.sample((k as f64 + 0.5) / 1000.0))
+            .collect();
         (xy, e.efficacy_lm_per_w(), draws)
     };
     let (xy, lm_w, draws) = at(1.0);
@@ -208,9 +210,15 @@ fn a_spectrum_scale_changes_neither_colour_nor_wavelengths() {
             (xy_s.x - xy.x).abs() < 1e-12 && (xy_s.y - xy.y).abs() < 1e-12,
             "scale {scale:e}: {xy_s:?} against {xy:?}"
         );
-        assert!((lm_w_s - lm_w).abs() < 1e-12 * lm_w, "scale {scale:e}: {lm_w_s} lm/W");
+        assert!(
+            (lm_w_s - lm_w).abs() < 1e-12 * lm_w,
+            "scale {scale:e}: {lm_w_s} lm/W"
+        );
         for (a, b) in draws.iter().zip(&draws_s) {
-            assert!((a - b).abs() < 1e-12 * a, "scale {scale:e}: drew {b} nm, not {a}");
+            assert!(
+                (a - b).abs() < 1e-12 * a,
+                "scale {scale:e}: drew {b} nm, not {a}"
+            );
         }
     }
 }
@@ -229,7 +237,11 @@ fn a_spectrum_file_scale_changes_nothing() {
             .map(|nm| format!("{nm}, {:e}\n", (1.0 + (nm as f64 / 37.0).sin()) * scale))
             .collect();
         std::fs::write(dir.path().join("led.csv"), text).unwrap();
-        s.build(&c, "sources[0].spectrum").unwrap().xyz_per_w().xy().unwrap()
+        s.build(&c, "sources[0].spectrum")
+            .unwrap()
+            .xyz_per_w()
+            .xy()
+            .unwrap()
     };
     let xy = colour(1.0);
     for scale in [1e306, 1e-300, 1e-310] {

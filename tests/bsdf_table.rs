@@ -318,7 +318,11 @@ fn the_loader_names_the_file_the_field_and_the_line() {
         "{e}"
     );
     let e = err(&format!("{base}\ntristimulus = \"W\""), &[("t.bsdf", &xyz)]);
-    assert!(e.contains("W") && e.contains("X"), "{e}");
+    assert!(
+        e.contains("surfaces.film.tristimulus: unknown channel 'W'")
+            && e.contains("\"X\", \"Y\" (photopic) or \"Z\""),
+        "{e}"
+    );
     // An unknown key, and a u_axis along the face's normal (checked against the face).
     let e = err(&format!("{base}\ncolour = 1"), &[("t.bsdf", &good)]);
     assert!(e.contains("colour"), "{e}");

@@ -233,3 +233,54 @@ fn summary_is_versioned_labelled_and_agrees_with_the_history() {
         "{from_csv} vs {from_summary}"
     );
 }
+
+/// A spectral run's report has a colour line: x, y, CCT and the debiased 13-point
+/// Δu'v', each with its error, the numbers of summary.json's `color` as printed.
+#[test]
+fn a_spectral_run_reports_its_colour_as_the_summary_has_it() {
+    let dir = tmp("colour");
+    let out = dir.path().join("o");
+    let run = blutrace(&[
+        "trace",
+        "scenes/notebook14-color",
+        "--photons",
+        "50000",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("colour     "))
+        .unwrap_or_else(|| panic!("no colour line in {stdout}"));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // The printed numbers in order: value and error of each quantity.
+    let printed: Vec<&str> = line
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|w| w.parse::<f64>().is_ok())
+        .collect();
+    let keys = [
+        ("x", 4),
+        ("y", 4),
+        ("cct_k", 0),
+        ("delta_uv_13pt_debiased", 4),
+    ];
+    assert_eq!(printed.len(), 2 * keys.len(), "{line}");
+    for (k, (key, digits)) in keys.iter().enumerate() {
+        for (j, part) in ["value", "stderr"].iter().enumerate() {
+            let want = s["color"][key][part].as_f64().unwrap();
+            assert_eq!(
+                printed[2 * k + j],
+                format!("{want:.digits$}"),
+                "{key}.{part}: {line}"
+            );
+        }
+    }
+    assert!(
+        line.contains("CCT ") && line.contains("Δu'v' 13-point"),
+        "{line}"
+    );
+}

@@ -193,3 +193,30 @@ fn monochrome_runs_have_no_colour() {
     let files = r.write(&out.path().join("run")).unwrap();
     assert!(!files.iter().any(|p| p.ends_with("color.exr")));
 }
+
+/// A source spectrum's scale is free: traced at 1e200, 1e306 or a subnormal 1e-310 times
+/// the same table, the target's colour is the table's at 1 (the draws agree to ~1e-13 nm;
+/// a scale at 1e200 drew every photon at the table's first row).
+#[test]
+fn a_spectrum_traces_the_same_colour_at_any_scale() {
+    let table = |s: &str| {
+        format!(
+            "{{ table = [[380, 0.2{s}], [450, 1.0{s}], [470, 0.3{s}], [560, 0.7{s}], [780, 0.1{s}]] }}"
+        )
+    };
+    let colour = |s: &str| {
+        let c = slab_run("scale", &table(s), "0.0", 20_000, 1)
+            .summary()
+            .color
+            .unwrap();
+        (c.x.value, c.y.value)
+    };
+    let want = colour("");
+    for s in ["e200", "e306", "e-310"] {
+        let got = colour(s);
+        assert!(
+            (got.0 - want.0).abs() < 1e-10 && (got.1 - want.1).abs() < 1e-10,
+            "scale 1{s}: x, y {got:?} against {want:?}"
+        );
+    }
+}

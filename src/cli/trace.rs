@@ -369,9 +369,31 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
             );
         }
     }
+    if let Some(c) = &s.color {
+        print_colour(c);
+    }
     for f in files {
         say!("wrote      {}", f.display());
     }
+}
+
+/// The colour line of a spectral run: the target's chromaticity, CCT and 13-point
+/// colour non-uniformity (noise removed), each with its error, as summary.json has them.
+fn print_colour(c: &blutrace::run::metrics::color::ColorSummary) {
+    let num = |e: &blutrace::run::metrics::Estimate, digits: usize| {
+        format!(
+            "{} ± {}",
+            err(e.value, digits, false),
+            err(e.stderr, digits, false)
+        )
+    };
+    say!(
+        "colour     x {}, y {}, CCT {} K, Δu'v' 13-point {} (debiased)",
+        num(&c.x, 4),
+        num(&c.y, 4),
+        num(&c.cct_k, 0),
+        num(&c.delta_uv_13pt_debiased, 4)
+    );
 }
 
 /// An error estimate with `digits` decimals (scientific with `sci`), or `n/a` when the

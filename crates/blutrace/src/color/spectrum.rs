@@ -129,6 +129,18 @@ impl Spectrum {
         }
     }
 
+    /// This spectrum divided by its largest value (`None` if every value is zero): the
+    /// same distribution at a scale where integrals of it and products with it neither
+    /// overflow (values near 1e306 summed over 400 nm) nor lose digits to subnormals.
+    /// Dividing, not multiplying by the reciprocal, which overflows for a subnormal peak.
+    pub fn normalized(&self) -> Option<Spectrum> {
+        let peak = self.value.iter().copied().fold(0.0, f64::max);
+        (peak > 0.0).then(|| Spectrum {
+            nm: self.nm.clone(),
+            value: self.value.iter().map(|v| v / peak).collect(),
+        })
+    }
+
     /// ∫ S(λ) dλ over the table (exact for the linear interpolant), in value·nm.
     pub fn integral(&self) -> f64 {
         self.rows()

@@ -249,3 +249,30 @@ fn bad_tables_are_refused_with_the_row_named() {
     assert!(message(&[[400.0, 1.0], [500.0, f64::INFINITY]]).contains("not a finite"));
     assert!(message(&[[0.0, 1.0], [500.0, 1.0]]).contains("positive"));
 }
+
+/// Efficacy and relative tristimulus values are ratios: a spectrum at 1e306 (whose
+/// integral overflows) or a subnormal 1e-310 gives those of the same spectrum at 1.
+#[test]
+fn ratios_of_a_spectrum_do_not_depend_on_its_scale() {
+    let d65 = CieIlluminant::D65.spectrum();
+    let peak = d65.rows().map(|r| r[1]).fold(0.0, f64::max);
+    let unit = d65.normalized().unwrap();
+    assert_eq!(unit.rows().map(|r| r[1]).fold(0.0, f64::max), 1.0);
+    let lm_w = luminous_efficacy(&unit).unwrap();
+    let xyz = Xyz::relative(&unit).unwrap();
+    for scale in [1e306, 1e-310] {
+        let rows: Vec<[f64; 2]> = d65.rows().map(|[nm, v]| [nm, v / peak * scale]).collect();
+        let s = Spectrum::from_rows(&rows).unwrap();
+        assert_near(
+            "efficacy",
+            luminous_efficacy(&s).unwrap(),
+            lm_w,
+            1e-12 * lm_w,
+        );
+        let got = Xyz::relative(&s).unwrap();
+        assert_near("X", got.x, xyz.x, 1e-10);
+        assert_near("Z", got.z, xyz.z, 1e-10);
+    }
+    let dark = Spectrum::from_rows(&[[400.0, 0.0], [500.0, 0.0]]).unwrap();
+    assert!(dark.normalized().is_none() && luminous_efficacy(&dark).is_none());
+}

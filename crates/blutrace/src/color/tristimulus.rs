@@ -96,7 +96,7 @@ impl Xyz {
 
     /// Relative tristimulus values of an illuminant, normalised to Y = 100 (None if Y = 0).
     pub fn relative(spd: &Spectrum) -> Option<Xyz> {
-        let xyz = Xyz::of(spd);
+        let xyz = Xyz::of(&spd.normalized()?);
         (xyz.y > 0.0).then(|| xyz.scaled(100.0 / xyz.y))
     }
 
@@ -162,6 +162,7 @@ impl UvPrime {
 /// The luminous efficacy of radiation of `spd`, in lm/W: K_m ∫ S ȳ dλ / ∫ S dλ, the radiant
 /// power counted over the spectrum's whole table (None if that is zero).
 pub fn luminous_efficacy(spd: &Spectrum) -> Option<f64> {
+    let spd = &spd.normalized()?;
     let radiant = spd.integral();
     (radiant > 0.0).then(|| KM_LM_PER_W * spd.integrate_product(&observer().y_bar) / radiant)
 }

@@ -77,8 +77,17 @@ impl PhaseTable {
         if rows[0][0] != 0.0 || rows[rows.len() - 1][0] != 180.0 {
             return Err("angles must run from 0 to 180 degrees".into());
         }
+        // Values relative to the largest: the scale is free, and the sums below would
+        // overflow near 1e306 or lose digits to subnormals.
+        let peak = rows.iter().map(|r| r[1]).fold(0.0, f64::max);
+        if peak <= 0.0 {
+            return Err("the values are all 0".into());
+        }
         let mut t = PhaseTable {
-            knots: rows.iter().map(|[a, v]| (a.to_radians(), *v)).collect(),
+            knots: rows
+                .iter()
+                .map(|[a, v]| (a.to_radians(), v / peak))
+                .collect(),
             cdf: Vec::with_capacity(TABLE_CELLS + 1),
             mean_cosine: 0.0,
         };
@@ -150,6 +159,34 @@ mod tests {
             assert!((norm - 1.0).abs() < 1e-4, "g {g}: norm {norm}");
             assert!((mean - g).abs() < 1e-4, "g {g}: mean cosine {mean}");
         }
+    }
+
+    /// A table's scale is free: at 1e308 (whose sums overflow) or a subnormal 1e-310 it
+    /// draws the directions, and has the mean cosine, of the same table at 1.
+    #[test]
+    fn a_phase_table_at_any_scale_is_the_same_distribution() {
+        let rows = [[0.0, 1.7], [10.0, 1.5], [60.0, 1.0], [180.0, 0.5]];
+        let at = |s: f64| {
+            let scaled: Vec<[f64; 2]> = rows.iter().map(|&[a, v]| [a, v * s]).collect();
+            PhaseTable::new(&scaled).unwrap()
+        };
+        let one = at(1.0);
+        for s in [1e308, 1e300, 1e-300, 1e-310] {
+            let t = at(s);
+            assert!(
+                (t.mean_cosine - one.mean_cosine).abs() < 1e-12,
+                "scale {s:e}: mean cosine {} against {}",
+                t.mean_cosine,
+                one.mean_cosine
+            );
+            for k in 0..100 {
+                let u = (k as f64 + 0.5) / 100.0;
+                let (a, b) = (t.cos_theta(u), one.cos_theta(u));
+                assert!((a - b).abs() < 1e-12, "scale {s:e}, u {u}: {a} against {b}");
+            }
+            assert!((t.density(0.3) - one.density(0.3)).abs() < 1e-12 * one.density(0.3));
+        }
+        assert!(PhaseTable::new(&[[0.0, 0.0], [180.0, 0.0]]).is_err());
     }
 
     #[test]

@@ -289,7 +289,10 @@ impl IntensityProfile {
                         c.value
                     );
                 }
-                *m += w * c.value * multiplier.value / total_weight;
+                // The multiplier and the candela scale drop out in the normalisation to
+                // the largest value; weights as fractions keep the mean within the
+                // largest value (a product near 1e306 would overflow).
+                *m += w / total_weight * c.value;
                 lines_of[j] = c.line;
             }
         }
@@ -620,6 +623,52 @@ mod tests {
             IntensityProfile::parse_ies(&tilt, Path::new("b.ies")).unwrap(),
             p
         );
+    }
+
+    /// A profile is relative: candela values or a multiplier at 1e306 (whose products
+    /// overflow) or 1e-300, or a CSV at 1e300 or a subnormal 1e-310, give the profile of
+    /// the same table at 1.
+    #[test]
+    fn profiles_at_any_scale_are_the_same() {
+        let ies = |t: &str| IntensityProfile::parse_ies(t, Path::new("a.ies")).unwrap();
+        let want = ies(IES);
+        let block = "1 2 1 0\n3 4 1 0\n1 2 1 0\n";
+        let candela = |s: &str| {
+            let scaled = format!("1{s} 2{s} 1{s} 0\n3{s} 4{s} 1{s} 0\n1{s} 2{s} 1{s} 0\n");
+            IES.replace(block, &scaled)
+        };
+        let close = |p: &IntensityProfile, what: &str| {
+            let (a, i) = p.table();
+            assert_eq!(a, want.table().0, "{what}");
+            for (g, w) in i.iter().zip(want.table().1) {
+                assert!((g - w).abs() < 1e-12, "{what}: {i:?}");
+            }
+            for u in [0.1, 0.5, 0.9] {
+                let (g, w) = (p.sample_theta(u), want.sample_theta(u));
+                assert!((g - w).abs() < 1e-12, "{what}: {g} against {w}");
+            }
+        };
+        close(&ies(&candela("e306")), "candela 1e306");
+        close(&ies(&candela("e-300")), "candela 1e-300");
+        close(
+            &ies(&IES.replace(" 1.0 4 3 ", " 1e306 4 3 ")),
+            "multiplier 1e306",
+        );
+        close(
+            &ies(&IES.replace(" 1.0 4 3 ", " 1e-300 4 3 ")),
+            "multiplier 1e-300",
+        );
+        let csv = |s: &str| {
+            let text = format!("0,2{s}\n30,3{s}\n60,1{s}\n90,0\n");
+            IntensityProfile::parse_csv(&text, Path::new("x.csv")).unwrap()
+        };
+        let one = csv("");
+        for s in ["e300", "e-300", "e-310"] {
+            let p = csv(s);
+            for (g, w) in p.table().1.iter().zip(one.table().1) {
+                assert!((g - w).abs() < 1e-12, "csv {s}: {:?}", p.table().1);
+            }
+        }
     }
 
     #[test]

@@ -55,7 +55,8 @@ use crate::color::Spectrum;
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::optics::medium::air;
 use crate::scene::geometry_file::{Units, affine_matrix, rotation_deg};
-use crate::spec_check::Ctx;
+use crate::sources::MAX_TOTAL_POWER_W;
+use crate::spec_check::{Ctx, short};
 use anyhow::{Result, bail};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
@@ -417,20 +418,40 @@ impl RayFileSpec {
         let dir = ctx.0.parent().unwrap_or(Path::new("."));
         let set = RaySet::read(&dir.join(&self.file))
             .map_err(|e| ctx.err(&f("file"), format!("{e:#}")))?;
-        if set.total_flux() <= 0.0 || !set.total_flux().is_finite() {
-            return Err(ctx.err(
-                &f("file"),
-                format!(
-                    "{}: the rays' total flux is {}: nothing to emit",
-                    self.file.display(),
-                    set.total_flux()
-                ),
-            ));
-        }
+        self.check_flux(ctx, at, &set)?;
         let (rot, shift) = self.placement(ctx, at)?;
         let scale = self.units.unwrap_or(Units::Mm).mm();
         RayFileEmitter::new(self.file.clone(), Arc::new(set), rot, scale, shift)
             .map_err(|e| ctx.err(&f("file"), format!("{}: {e:#}", self.file.display())))
+    }
+
+    /// The rays' total flux must be positive and finite; without `power_w` it is the
+    /// source's radiant power, which must stay within [`MAX_TOTAL_POWER_W`] (with it, the
+    /// flux only weighs the rays against each other, at any scale).
+    fn check_flux(&self, ctx: &Ctx, at: &str, set: &RaySet) -> Result<()> {
+        let total = set.total_flux();
+        let why = if !(total > 0.0 && total.is_finite()) {
+            "nothing to emit"
+        } else if self.power_w.is_none() && set.unit == FluxUnit::Watt && total > MAX_TOTAL_POWER_W
+        {
+            &format!(
+                "too large for the source's power (at most {MAX_TOTAL_POWER_W:e} W): give power_w, and the rays' flux only weighs them against each other"
+            )
+        } else {
+            return Ok(());
+        };
+        Err(ctx.err(
+            &format!("{at}.file"),
+            format!(
+                "{}: the rays' total flux is {} {}, {why}",
+                self.file.display(),
+                short(total),
+                match set.unit {
+                    FluxUnit::Watt => "W",
+                    FluxUnit::Lumen => "lm",
+                }
+            ),
+        ))
     }
 
     /// The rotation and translation, checked (a matrix must be rigid: a rotation,

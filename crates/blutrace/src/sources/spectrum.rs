@@ -145,8 +145,8 @@ impl SpectrumSpec {
 /// Rows `nm, value` of a spectrum file.
 fn read_file(ctx: &Ctx, field: &str, file: &Path) -> Result<Spectrum> {
     let path = ctx.0.parent().unwrap_or(Path::new(".")).join(file);
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| ctx.err(field, format!("cannot read {}: {e}", path.display())))?;
+    let text = crate::input_file::read_text(&path, "spectrum file")
+        .map_err(|e| ctx.err(field, format!("{e:#}")))?;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -192,7 +192,11 @@ pub struct EmissionSpectrum {
 
 impl EmissionSpectrum {
     /// The part of `spectrum` within [`VISIBLE_NM`] (`None` if it has no power there).
+    /// Its absolute scale is dropped first ([`Spectrum::normalized`]): the sampler squares
+    /// values and the colour sums products, which a table at 1e200 or 1e-310 would
+    /// overflow or round away.
     pub fn new(spectrum: &Spectrum) -> Option<EmissionSpectrum> {
+        let spectrum = &spectrum.normalized()?;
         let (lo, hi) = VISIBLE_NM;
         let (first, last) = spectrum.range_nm();
         let (a, b) = (first.max(lo), last.min(hi));
@@ -238,7 +242,14 @@ impl EmissionSpectrum {
     /// the union of their knots, a part's step at an end taken over [`MIX_STEP_NM`]. `None`
     /// if no weight is positive.
     pub fn mixture(parts: &[(f64, &EmissionSpectrum)]) -> Option<EmissionSpectrum> {
-        let parts: Vec<_> = parts.iter().filter(|(w, _)| *w > 0.0).collect();
+        // Weights relative to the largest: only their ratios matter, and a sum of weights
+        // near f64::MAX would overflow.
+        let top = parts.iter().map(|(w, _)| *w).fold(0.0, f64::max);
+        let parts: Vec<(f64, &EmissionSpectrum)> = parts
+            .iter()
+            .filter(|(w, _)| *w > 0.0)
+            .map(|&(w, s)| (w / top, s))
+            .collect();
         let total: f64 = parts.iter().map(|(w, _)| w).sum();
         if parts.is_empty() || !total.is_finite() {
             return None;

@@ -110,9 +110,10 @@ pub struct BsdfTableSpec {
     /// The direction of sample rotation 0 on the face.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub u_axis: Option<[f64; 3]>,
-    /// XYZ files: the tristimulus channel to trace.
+    /// XYZ files: the tristimulus channel to trace, "X", "Y" or "Z" (read as text and
+    /// checked in `build`, so an error names `surfaces.TAG.tristimulus`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tristimulus: Option<Channel>,
+    pub tristimulus: Option<String>,
 }
 
 /// One scatter type's table, ready to sample.
@@ -332,9 +333,10 @@ impl SurfaceSpecOf for BsdfTableSpec {
     type Model = BsdfTable;
 
     fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<BsdfTable> {
+        let channel = tristimulus(ctx, at, self.tristimulus.as_deref())?;
         let read = |key: &str, files: &Files| {
             let field = format!("{at}.{key}");
-            read_side(ctx, (&field, at), &files.list(), self.tristimulus)
+            read_side(ctx, (&field, at), &files.list(), channel)
         };
         let (front, front_btdf) = read("file", &self.file)?;
         let back = self
@@ -441,6 +443,22 @@ fn read_tables(
         }
     }
     Ok((brdf, btdf))
+}
+
+/// The channel `tristimulus = name` of the surface at `at` names.
+fn tristimulus(ctx: &Ctx, at: &str, name: Option<&str>) -> Result<Option<Channel>> {
+    let Some(name) = name else {
+        return Ok(None);
+    };
+    match name {
+        "X" => Ok(Some(Channel::X)),
+        "Y" => Ok(Some(Channel::Y)),
+        "Z" => Ok(Some(Channel::Z)),
+        other => Err(ctx.err(
+            &format!("{at}.tristimulus"),
+            format!("unknown channel '{other}': expected \"X\", \"Y\" (photopic) or \"Z\""),
+        )),
+    }
 }
 
 /// Whether a section of `path` holding `found` (`None`: Monochrome) is traced when the

@@ -29,7 +29,7 @@
 //! a table in such a scene is read at its wavelength.
 
 use crate::color::cie_cmf::{CMF_FIRST_NM, CMF_STEP_NM};
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::Result;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::sync::Arc;
@@ -189,13 +189,15 @@ impl Serialize for Spectral {
 }
 
 impl std::fmt::Display for Spectral {
-    /// A constant as an `f64` is formatted; a table as its range over 360-830 nm.
+    /// A constant as an `f64` is formatted when a precision is given, else in short form
+    /// ([`short`]: `1e300`, not 301 digits); a table as its range over 360-830 nm.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Spectral::Constant(v) => std::fmt::Display::fmt(v, f),
+            Spectral::Constant(v) if f.precision().is_some() => std::fmt::Display::fmt(v, f),
+            Spectral::Constant(v) => f.write_str(&short(*v)),
             Spectral::Sampled(_) => {
                 let (lo, hi) = self.range();
-                write!(f, "{lo}..{hi} over 360-830 nm")
+                write!(f, "{}..{} over 360-830 nm", short(lo), short(hi))
             }
         }
     }
@@ -424,7 +426,11 @@ fn check_range(ctx: &Ctx, field: &str, q: &Spectral, range: Range) -> Result<()>
     };
     Err(ctx.err(
         field,
-        format!("must be {want} at every wavelength from 360 to 830 nm, but ranges {lo}..{hi}"),
+        format!(
+            "must be {want} at every wavelength from 360 to 830 nm, but ranges {}..{}",
+            short(lo),
+            short(hi)
+        ),
     ))
 }
 

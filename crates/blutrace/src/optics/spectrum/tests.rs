@@ -99,3 +99,19 @@ fn a_number_round_trips_as_a_number() {
     assert_eq!(v, SpectralValue::Constant(0.5));
     assert_eq!(serde_json::to_string(&v).unwrap(), "0.5");
 }
+
+/// Huge values are written short, in reports and in errors (not as 301 digits), and a
+/// precision given to the formatter still holds for a constant.
+#[test]
+fn huge_values_print_short() {
+    let n = build("{ cauchy = [1e300] }", Range::Index).unwrap();
+    assert_eq!(n.to_string(), "1e300..1e300 over 360-830 nm");
+    assert_eq!(Spectral::constant(1e300).to_string(), "1e300");
+    assert_eq!(Spectral::constant(1.49).to_string(), "1.49");
+    assert_eq!(format!("{:.3}", Spectral::constant(1.49)), "1.490");
+    let e = build("{ cauchy = [-1e300] }", Range::Index).unwrap_err();
+    assert!(
+        e.contains("media.pmma.n: must be positive") && e.contains("ranges -1e300..-1e300"),
+        "{e}"
+    );
+}

@@ -543,3 +543,74 @@ fn the_summary_names_the_tables_per_ray() {
         "{e}"
     );
 }
+
+/// A spectral table's scale is free (TM-25-13 4.7.4: relative power): the file's table,
+/// and its tables per ray, at 1e300 or 1e-300 give the colour and the draws of the same
+/// tables at 1.
+#[test]
+fn spectral_tables_at_any_scale_draw_the_same_wavelengths() {
+    let scaled = |rows: &[[f64; 2]], s: f64| -> Vec<[f64; 2]> {
+        rows.iter().map(|&[nm, v]| [nm, v * s]).collect()
+    };
+    let looks = |set: &RaySet| {
+        let e = set.emission_spectrum().unwrap().unwrap();
+        let mut draws = vec![e.xyz_per_w().xy().unwrap().x, e.efficacy_lm_per_w()];
+        for t in set.table_spectra().unwrap() {
+            draws.extend((0..100).map(|k| t.sample((k as f64 + 0.5) / 100.0)));
+        }
+        draws
+    };
+    let at = |s: f64| {
+        let mut one = sample_set();
+        one.nm.clear();
+        one.spectrum = FileSpectrum::Table(scaled(&blue_and_yellow()[1], s));
+        let mut many = tables_set();
+        if let FileSpectrum::Tables(t) = &mut many.spectrum {
+            t.iter_mut().for_each(|rows| *rows = scaled(rows, s));
+        }
+        [looks(&one), looks(&many)]
+    };
+    let want = at(1.0);
+    for s in [1e300, 1e-300] {
+        for (got, want) in at(s).iter().zip(&want) {
+            for (g, w) in got.iter().zip(want) {
+                assert!(
+                    (g - w).abs() <= 1e-12 * w.abs(),
+                    "scale {s:e}: {g} against {w}"
+                );
+            }
+        }
+    }
+}
+
+/// Rays whose flux sums to 3.4e39 W, with no `power_w`, would be the source's power: the
+/// error names the entry's file field and the file, and says the rays' flux is too large
+/// (not a `power_w` the scene never set). Given `power_w`, the flux only weighs the rays.
+#[test]
+fn rays_too_bright_for_a_source_are_named_at_the_file() {
+    let mut set = sample_set();
+    set.nm.clear();
+    set.spectrum = FileSpectrum::None;
+    set.rays = (0..11)
+        .map(|_| ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], 3.1e38))
+        .collect();
+    let (dir, _) = written(&set);
+    let scene = dir.path().join("scene.toml");
+    let spec = |extra: &str| -> RayFileSpec {
+        toml::from_str(&format!("file = \"led.TM25RAY\"\n{extra}")).unwrap()
+    };
+    let e = format!(
+        "{:#}",
+        spec("").emitter(&Ctx(&scene), "sources[1]").unwrap_err()
+    );
+    assert!(
+        e.contains(
+            "scene.toml: sources[1].file: led.TM25RAY: the rays' total flux is 3.41e39 W, too large"
+        ),
+        "{e}"
+    );
+    let e = spec("power_w = 0.5")
+        .emitter(&Ctx(&scene), "sources[1]")
+        .unwrap();
+    assert!((e.probability(3) - 1.0 / 11.0).abs() < 1e-6);
+}

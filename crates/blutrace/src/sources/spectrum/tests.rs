@@ -122,6 +122,29 @@ fn spectrum_files_read_with_a_header_and_comments() {
     );
 }
 
+/// A spectrum file is read as every input is: a FIFO or a link to /dev/zero is refused
+/// at once, naming the field and the file (not a read that blocks or fills memory).
+#[test]
+fn spectrum_files_must_be_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let c = Ctx(&scene);
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.csv")).unwrap();
+    let fifo = dir.path().join("fifo.csv");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.unwrap().success());
+    for name in ["zero.csv", "fifo.csv"] {
+        let s = spec(&format!("{{ file = \"{name}\" }}")).unwrap();
+        let e = format!("{:#}", s.build(&c, "sources[2].spectrum").unwrap_err());
+        assert!(
+            e.contains("scene.toml: sources[2].spectrum")
+                && e.contains(name)
+                && e.contains("cannot read spectrum file: not a regular file"),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn bad_spectra_are_named() {
     let e = build("\"cie-led-b9\"").unwrap_err();
@@ -158,4 +181,86 @@ fn a_mixture_weighs_its_parts_colour_and_table_by_their_weights() {
     let above_550 = draws.iter().filter(|&&w| w > 550.0).count();
     assert!((1249..=1251).contains(&above_550), "{above_550}");
     assert!(EmissionSpectrum::mixture(&[(0.0, &blue)]).is_none());
+}
+
+/// A spectrum's absolute scale says nothing of its colour or its photons' wavelengths:
+/// the same table at 1e200, 1e306, 1e-200 and a subnormal 1e-310 gives the colour and the
+/// draws of the table at 1 (products of values and squares of values would overflow or
+/// lose their digits at those scales).
+#[test]
+fn a_spectrum_scale_changes_neither_colour_nor_wavelengths() {
+    let rows: Vec<[f64; 2]> = CieIlluminant::LedB3
+        .spectrum()
+        .rows()
+        .map(|[nm, v]| [nm, v / 2.0])
+        .collect();
+    let at = |scale: f64| {
+        let scaled: Vec<[f64; 2]> = rows.iter().map(|&[nm, v]| [nm, v * scale]).collect();
+        let e = EmissionSpectrum::new(&Spectrum::from_rows(&scaled).unwrap()).unwrap();
+        let xy = e.xyz_per_w().xy().unwrap();
+        let draws: Vec<f64> = (0..1000)
+            .map(|k| e.sample((k as f64 + 0.5) / 1000.0))
+            .collect();
+        (xy, e.efficacy_lm_per_w(), draws)
+    };
+    let (xy, lm_w, draws) = at(1.0);
+    for scale in [1e200, 1e306, 1e-200, 1e-310] {
+        let (xy_s, lm_w_s, draws_s) = at(scale);
+        assert!(
+            (xy_s.x - xy.x).abs() < 1e-12 && (xy_s.y - xy.y).abs() < 1e-12,
+            "scale {scale:e}: {xy_s:?} against {xy:?}"
+        );
+        assert!(
+            (lm_w_s - lm_w).abs() < 1e-12 * lm_w,
+            "scale {scale:e}: {lm_w_s} lm/W"
+        );
+        for (a, b) in draws.iter().zip(&draws_s) {
+            assert!(
+                (a - b).abs() < 1e-12 * a,
+                "scale {scale:e}: drew {b} nm, not {a}"
+            );
+        }
+    }
+}
+
+/// A spectrum file's scale is as free as a table's: the file at 1e306 (whose integral
+/// overflows) or a subnormal 1e-310 times the values gives the same colour.
+#[test]
+fn a_spectrum_file_scale_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let c = Ctx(&scene);
+    let s = spec("{ file = \"led.csv\" }").unwrap();
+    let colour = |scale: f64| {
+        let text: String = (400..=700)
+            .step_by(10)
+            .map(|nm| format!("{nm}, {:e}\n", (1.0 + (nm as f64 / 37.0).sin()) * scale))
+            .collect();
+        std::fs::write(dir.path().join("led.csv"), text).unwrap();
+        s.build(&c, "sources[0].spectrum")
+            .unwrap()
+            .xyz_per_w()
+            .xy()
+            .unwrap()
+    };
+    let xy = colour(1.0);
+    for scale in [1e306, 1e-300, 1e-310] {
+        let xy_s = colour(scale);
+        assert!(
+            (xy_s.x - xy.x).abs() < 1e-12 && (xy_s.y - xy.y).abs() < 1e-12,
+            "scale {scale:e}: {xy_s:?} against {xy:?}"
+        );
+    }
+}
+
+/// A mixture's weights count by their ratios: weights whose sum overflows mix as the same
+/// weights at a small scale.
+#[test]
+fn a_mixture_of_huge_weights_is_the_mixture_of_their_ratios() {
+    let part = |rows: &[[f64; 2]]| EmissionSpectrum::new(&Spectrum::from_rows(rows).unwrap());
+    let blue = part(&[[440.0, 0.0], [460.0, 1.0], [480.0, 0.0]]).unwrap();
+    let yellow = part(&[[500.0, 1.0], [600.0, 1.0]]).unwrap();
+    let small = EmissionSpectrum::mixture(&[(3.0, &blue), (1.0, &yellow)]).unwrap();
+    let huge = EmissionSpectrum::mixture(&[(1.5e308, &blue), (0.5e308, &yellow)]).unwrap();
+    assert_eq!(huge, small);
 }

@@ -80,10 +80,15 @@ fn the_sixty_degree_slab_transmits_s_and_p_apart() {
 /// A scene of sheets in air under a beam going straight down from z = 5, `sheets` its
 /// `[surfaces.*]` entries, `obj` their geometry.
 fn sheets_scene(obj: &str, sheets: &str, name: &str, photons: u64) -> RunResult {
+    polarized_beam(obj, sheets, "", name, photons)
+}
+
+/// [`sheets_scene`] with the beam's `polarization = ...` line `state` (or none).
+fn polarized_beam(obj: &str, sheets: &str, state: &str, name: &str, photons: u64) -> RunResult {
     let rays = "0 0 5  0 0 -1  1.0\n";
     let toml = format!(
         "version = 1\n[[geometry]]\nfile = \"sheets.obj\"\n{sheets}\
-         [[sources]]\ntype = \"rayfile\"\nfile = \"beam.rays\"\nbody = \"transparent\"\n{DOWN}"
+         [[sources]]\ntype = \"rayfile\"\nfile = \"beam.rays\"\nbody = \"transparent\"\n{state}\n{DOWN}"
     );
     run(
         name,
@@ -91,6 +96,47 @@ fn sheets_scene(obj: &str, sheets: &str, name: &str, photons: u64) -> RunResult 
         &[("sheets.obj", obj), ("beam.rays", rays)],
         photons,
     )
+}
+
+/// A source's polarization, relative to its u axis (a ray file's x): linear at 30
+/// degrees passes `cos^2 30 = 0.75` of an ideal polarizer along x, circular light half,
+/// linear across it nothing; with no polarizer the target sees the source's state.
+#[test]
+fn a_polarized_source_starts_its_photons_in_its_state() {
+    let obj = sheet("film", 0.0, 100.0, 0);
+    let film = polarizer("film", 0.0, 0.0);
+    for (state, want) in [
+        ("polarization = { linear_deg = 30.0 }", 0.75),
+        ("polarization = { stokes = [2.0, 0.0, 0.0, 2.0] }", 0.5),
+        ("polarization = { linear_deg = 90.0 }", 0.0),
+    ] {
+        let r = polarized_beam(&obj, &film, state, "source-state", 20_000);
+        let (t, se) = efficiency(&r);
+        assert!(
+            (t - want).abs() < 4.0 * se + 1e-9,
+            "{state}: {t} ± {se}, want {want}"
+        );
+    }
+    // A sheet out of the beam's way: the target sees the source's state; both frames are
+    // u = x, v = direction x u = -y for light going down.
+    let aside = "[surfaces.film]\nmodel = \"lambert\"\nalbedo = 0.5\n";
+    let state = "polarization = { linear_deg = 30.0 }";
+    let r = polarized_beam(
+        &sheet("film", -10.0, 1.0, 0),
+        aside,
+        state,
+        "source-seen",
+        2_000,
+    );
+    let p = r
+        .summary()
+        .polarization
+        .expect("a polarized source traces polarization");
+    let s2 = 0.75f64.sqrt();
+    assert!(
+        (p.s1.value - 0.5).abs() < 1e-9 && (p.s2.value - s2).abs() < 1e-9,
+        "{p:?}"
+    );
 }
 
 fn polarizer(tag: &str, axis_deg: f64, block_reflectance: f64) -> String {

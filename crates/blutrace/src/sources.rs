@@ -23,6 +23,7 @@ pub mod body_shape;
 pub mod ccfl;
 pub mod intensity;
 pub mod led;
+pub mod polarization;
 pub mod rayfile;
 pub mod spectrum;
 
@@ -61,6 +62,7 @@ struct Common<'a> {
     power_w: Option<f64>,
     lumens: Option<f64>,
     spectrum: Option<&'a SpectrumSpec>,
+    polarization: Option<&'a polarization::SourcePolarizationSpec>,
     medium: &'a str,
     body: &'a BodySpec,
     package_depth_mm: Option<f64>,
@@ -110,6 +112,7 @@ impl SourceSpec {
                 power_w: Some(s.power_w),
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: None,
@@ -119,6 +122,7 @@ impl SourceSpec {
                 power_w: Some(s.power_w),
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: s.package_depth_mm,
@@ -128,6 +132,7 @@ impl SourceSpec {
                 power_w: s.power_w,
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: s.package_depth_mm,
@@ -187,6 +192,10 @@ impl SourceSpec {
             },
             lumens: ctx.optional_positive(&f("lumens"), common.lumens)?,
             spectrum: spectrum.map(Arc::new),
+            polarization: common
+                .polarization
+                .map(|p| p.build(ctx, &f("polarization")))
+                .transpose()?,
             emitter,
             medium: medium_id(ctx, &f("medium"), common.medium, media)?,
             body,
@@ -244,6 +253,16 @@ impl Emitter {
                 Some(r.set.total_flux())
             }
             _ => None,
+        }
+    }
+
+    /// The axis a source's `polarization` is given against: an LED's `u`, a tube's axis,
+    /// a ray file's placed x axis.
+    pub fn u_axis(&self) -> DVec3 {
+        match self {
+            Emitter::Ccfl(t) => t.axis,
+            Emitter::Led(l) => l.u,
+            Emitter::RayFile(r) => r.front.u,
         }
     }
 
@@ -331,6 +350,9 @@ pub struct Source {
     pub lumens: Option<f64>,
     /// Its emission spectrum (`None`: monochrome light).
     pub spectrum: Option<Arc<EmissionSpectrum>>,
+    /// The state its light starts in, in the frame of [`Emitter::u_axis`] (`None`:
+    /// unpolarized).
+    pub polarization: Option<crate::optics::polarization::Stokes>,
     /// Shape and angular profile.
     pub emitter: Emitter,
     /// Medium the source emits into.

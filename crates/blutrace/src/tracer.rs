@@ -133,7 +133,7 @@ impl<'a> Tracer<'a> {
             pol: self
                 .scene
                 .polarized
-                .then(|| Polarization::unpolarized(e.ray.dir)),
+                .then(|| emitted_polarization(self.scene, &e)),
             absorption_depth: -1.0,
         };
         out.ledger.photons += 1;
@@ -462,6 +462,21 @@ fn absorb_clear(
             p.weight = w;
             false
         }
+    }
+}
+
+/// The state a photon leaves its source `e.source` in: the source's, in the frame of its
+/// u axis made perpendicular to the photon's direction, or unpolarized.
+fn emitted_polarization(scene: &Scene, e: &crate::sources::Emission) -> Polarization {
+    let d = e.ray.dir;
+    let source = &scene.sources.list[e.source];
+    let frame = source.emitter.u_axis();
+    match (
+        source.polarization,
+        (frame - frame.dot(d) * d).try_normalize(),
+    ) {
+        (Some(stokes), Some(u)) => Polarization { stokes, u },
+        _ => Polarization::unpolarized(d),
     }
 }
 

@@ -176,7 +176,7 @@ impl Scene {
             &media,
             &sources.list,
         )?;
-        let polarized = traces_polarization(&ctx, file, &surfaces, &backs)?;
+        let polarized = traces_polarization(&ctx, file, (&surfaces, &backs), &sources)?;
         let detector = file.detector.build(&ctx)?;
         if file.trace.photons == 0 {
             return Err(ctx.err("trace.photons", "must be at least 1"));
@@ -557,23 +557,24 @@ fn fit_models_to_faces(
 }
 
 /// Whether the scene traces polarization: `[trace] polarization`, else whether a surface
-/// is a polarizer (which needs it: `false` with one is an error).
+/// is a polarizer (which needs it: `false` with one is an error) or a source polarized.
 fn traces_polarization(
     ctx: &Ctx,
     file: &SceneFile,
-    surfaces: &[SurfaceModel],
-    backs: &[Option<SurfaceModel>],
+    (surfaces, backs): (&[SurfaceModel], &[Option<SurfaceModel>]),
+    sources: &Sources,
 ) -> Result<bool> {
     let all = surfaces.iter().chain(backs.iter().flatten());
     let polarizer = all
         .into_iter()
         .any(|m| matches!(m, SurfaceModel::Polarizer(_)));
+    let polarized_source = sources.list.iter().any(|s| s.polarization.is_some());
     match file.trace.polarization {
         Some(false) if polarizer => Err(ctx.err(
             "trace.polarization",
             "is false, but a surface is a polarizer, which needs polarization traced",
         )),
         Some(on) => Ok(on),
-        None => Ok(polarizer),
+        None => Ok(polarizer || polarized_source),
     }
 }

@@ -242,3 +242,56 @@ fn lambertian_mean_s1_through_an_x_polarizer() -> f64 {
     }
     sum / weight
 }
+
+/// Total internal reflection retards p against s: a beam linear at 45 degrees to the
+/// plane of incidence enters a right-angle PMMA prism through a leg at normal incidence,
+/// reflects totally off the hypotenuse at 45 degrees and leaves through the other leg:
+/// `|S3/S0| = sin(delta)`, `tan(delta/2) = cos_i sqrt(sin_i^2 - n^2) / sin_i^2` with
+/// n = 1/1.49, 0.573 (normal incidence keeps s and p in step).
+#[test]
+fn total_internal_reflection_turns_linear_light_elliptic() {
+    // Cross-section (x, z): (0,0), (10,0), (0,10), along y from -50 to 50; tags per face.
+    let obj = "v 0 -50 0\nv 10 -50 0\nv 0 -50 10\nv 0 50 0\nv 10 50 0\nv 0 50 10\nusemtl prism\n\
+               f 1 3 2\nf 4 5 6\nf 1 2 5\nf 1 5 4\nf 1 4 6\nf 1 6 3\nf 2 3 6\nf 2 6 5\n";
+    let toml = "version = 1\n[[geometry]]\nfile = \"prism.obj\"\n[media.pmma]\nn = 1.49\n\
+                [surfaces.prism]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+                [[sources]]\ntype = \"rayfile\"\nfile = \"beam.rays\"\nbody = \"transparent\"\n\
+                polarization = { linear_deg = 45.0 }\n\
+                [detector]\norigin = [-5.0, -50.0, 0.0]\nu = [0.0, 0.0, 1.0]\nv = [0.0, 1.0, 0.0]\n\
+                size_mm = [10.0, 100.0]\nbins = [2, 2]\n";
+    let rays = "3 0 -5  0 0 1  1.0\n";
+    let r = run("tir", toml, &[("prism.obj", obj), ("beam.rays", rays)], 20_000);
+    let p = r.summary().polarization.expect("a polarized source traces polarization");
+    let n: f64 = 1.0 / 1.49;
+    let (s, c) = 45f64.to_radians().sin_cos();
+    let want = (2.0 * (c * (s * s - n * n).sqrt() / (s * s)).atan()).sin();
+    assert!((want - 0.573).abs() < 1e-3);
+    // A few photons come back after three reflections (two partial ones): 2e-3 allowed.
+    assert!((p.s3.value.abs() - want).abs() < 2e-3, "{p:?}, want |S3| {want}");
+    assert!((p.dop.value - 1.0).abs() < 2e-3, "{p:?}");
+}
+
+/// Brewster's angle: p-polarized light reflects nothing off a PMMA slab (nor off its far
+/// face, where the inside angle is Brewster's too), s light some.
+#[test]
+fn brewsters_angle_reflects_no_p_light() {
+    let brewster = 1.49f64.atan();
+    let (s, c) = brewster.sin_cos();
+    let rays = format!("0 0 5  {s} 0 {}  1.0\n", -c);
+    let obj = support::box_obj([-250.0, -250.0, -0.5], [250.0, 250.0, 0.5], ["slab"; 6]);
+    let up = "[detector]\norigin = [-300.0, -300.0, 6.0]\nu = [1.0, 0.0, 0.0]\n\
+              v = [0.0, 1.0, 0.0]\nsize_mm = [600.0, 600.0]\nbins = [2, 2]\n";
+    let reflected = |deg: f64| {
+        let toml = format!(
+            "version = 1\n[[geometry]]\nfile = \"slab.obj\"\n[media.pmma]\nn = 1.49\n\
+             [surfaces.slab]\nmodel = \"dielectric\"\ninside = \"pmma\"\n\
+             [[sources]]\ntype = \"rayfile\"\nfile = \"beam.rays\"\nbody = \"transparent\"\n\
+             polarization = {{ linear_deg = {deg} }}\n{up}"
+        );
+        let files = [("slab.obj", obj.as_str()), ("beam.rays", rays.as_str())];
+        efficiency(&run("brewster", &toml, &files, 20_000)).0
+    };
+    // The ray file's u is x, in the plane of incidence: 0 degrees is p, 90 is s.
+    assert_eq!(reflected(0.0), 0.0);
+    assert!(reflected(90.0) > 0.2, "s light reflects from both faces");
+}

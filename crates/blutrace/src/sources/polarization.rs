@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 /// `polarization = { ... }` of a `[[sources]]` entry.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
-#[serde(untagged, deny_unknown_fields)]
+#[serde(untagged, try_from = "Keys")]
 pub enum SourcePolarizationSpec {
     /// Fully linearly polarized at `linear_deg` degrees from u towards v.
     Linear {
@@ -33,6 +33,26 @@ pub enum SourcePolarizationSpec {
         /// The vector.
         stokes: [f64; 4],
     },
+}
+
+/// The table as written, so that an unknown or missing key gets a message naming the keys.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Keys {
+    linear_deg: Option<f64>,
+    stokes: Option<[f64; 4]>,
+}
+
+impl TryFrom<Keys> for SourcePolarizationSpec {
+    type Error = String;
+
+    fn try_from(k: Keys) -> Result<Self, String> {
+        match (k.linear_deg, k.stokes) {
+            (Some(linear_deg), None) => Ok(SourcePolarizationSpec::Linear { linear_deg }),
+            (None, Some(stokes)) => Ok(SourcePolarizationSpec::Stokes { stokes }),
+            _ => Err("polarization: give one of { linear_deg = D } or { stokes = [S0, S1, S2, S3] }".into()),
+        }
+    }
 }
 
 impl SourcePolarizationSpec {

@@ -256,6 +256,7 @@ impl Polarization {
 /// under total internal reflection), else refracted; `pol` becomes the state of the
 /// light that leaves, in the frame `u = s`. `None` for `pol` is the averaged roulette,
 /// with the same random numbers.
+#[inline]
 pub fn fresnel_roulette(
     dir: DVec3,
     facing: DVec3,

@@ -16,8 +16,8 @@ use blutrace::run::RunResult;
 use glam::DVec3;
 use std::f64::consts::PI;
 use support::bsdf::{
-    GAP, GGX_FILM, PET, UP, film_table, lambert_table, model, polar_sums, scatter, section,
-    sheet_run, stack, steps,
+    GAP, GGX_FILM, PET, UP, film_table, lambert_table, model, polar_sums, rotated, scatter,
+    section, sheet_run, stack, steps,
 };
 use support::{chi2_quantile, load, write_scene};
 
@@ -366,6 +366,119 @@ fn the_content_hash_covers_the_table() {
     assert_ne!(load(&a).content_hash(), load(&b).content_hash());
 }
 
+/// A BRDF block at normal incidence on radial nodes 0, 60 and 120 degrees (cells to 30,
+/// 90 and 150) whose only value is `f(r)` at node `r` of `nonzero`.
+fn one_ring(nonzero: f64) -> String {
+    let s = section(
+        ScatterType::Brdf,
+        (&[0.0], &[0.0, 180.0], &[0.0, 60.0, 120.0]),
+        true,
+        |_| 0.5,
+        |_, r| if r == nonzero { 1.0 } else { 0.0 },
+    );
+    format::write(&[s], &[])
+}
+
+#[test]
+fn a_table_whose_values_lie_below_the_surface_is_refused() {
+    // The cell of node 120 runs from 90 to 150 degrees: it only touches the surface,
+    // and drawing from it took 10,000 rejections a photon.
+    let base = "model = \"bsdf_table\"\nfile = \"below.bsdf\"";
+    let e = format!(
+        "{:#}",
+        model(base, &[("below.bsdf", &one_ring(120.0))]).unwrap_err()
+    );
+    assert!(
+        e.contains("surfaces.film.file")
+            && e.contains(
+                "below.bsdf: line 16: TIS 0.5 of the BRDF block at AOI 0 deg, rotation 0 deg"
+            )
+            && e.contains("below the surface: 0.00 %"),
+        "{e}"
+    );
+    // The cell of node 60 (30 to 90 degrees) lies above it: kept, and it scatters there.
+    let m = model(base, &[("below.bsdf", &one_ring(60.0))]).unwrap();
+    let out = scatter(&m, 0.0, 2000, Estimator::Analog);
+    let k = out.len() as f64;
+    assert!((k / 2000.0 - 0.5).abs() < 0.05, "{k}");
+    assert!(
+        out.iter()
+            .all(|(d, _)| (0.0..=3f64.sqrt() / 2.0 + 1e-9).contains(&d.z)),
+        "a direction outside the cell of node 60"
+    );
+}
+
+#[test]
+fn tables_on_different_rotation_grids_must_add_up_where_they_are_read() {
+    // At each table's nodes the other's nearest node holds the complement (0.1 + 0.9),
+    // but between them (rotation 60: the BRDF's 90, the BTDF's 40) both hold 0.9.
+    let r = rotated(ScatterType::Brdf, &[0.0, 90.0, 180.0, 270.0], |rot| {
+        if rot % 180.0 == 0.0 { 0.1 } else { 0.9 }
+    });
+    let t = rotated(ScatterType::Btdf, &[40.0, 130.0, 220.0, 310.0], |rot| {
+        if rot == 40.0 || rot == 220.0 {
+            0.9
+        } else {
+            0.1
+        }
+    });
+    let two = "model = \"bsdf_table\"\nfile = [\"r.bsdf\", \"t.bsdf\"]\ninside = \"pet\"";
+    let e = format!(
+        "{:#}",
+        model(two, &[("r.bsdf", &r), ("t.bsdf", &t)]).unwrap_err()
+    );
+    assert!(
+        e.contains("surfaces.film.file")
+            && e.contains("sample rotation ")
+            && e.contains("r.bsdf, its rotation 90 deg")
+            && e.contains("t.bsdf, its rotation 40 deg")
+            && e.contains("add up to 1.8"),
+        "{e}"
+    );
+    // The same grids with a BTDF of 0.1 everywhere add up to 1 at most: they load.
+    let t = rotated(ScatterType::Btdf, &[40.0, 130.0, 220.0, 310.0], |_| 0.1);
+    model(two, &[("r.bsdf", &r), ("t.bsdf", &t)]).unwrap();
+}
+
+#[test]
+fn a_lamp_bodys_table_is_in_the_content_hash_and_shards_of_two_tables_do_not_merge() {
+    use blutrace::run::{RunOptions, Shard};
+    use blutrace::shard::{self, ShardFile};
+    let body = "power_w = 1.0\nbody = { model = \"bsdf_table\", file = \"body.bsdf\" }\n";
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\n{}",
+        LED.replacen("power_w = 1.0\n", body, 1)
+    );
+    let obj = "v -9 -9 0\nv 9 -9 0\nv 9 9 0\nv -9 9 0\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
+    let scene = |name: &str, albedo: f64| {
+        let table = lambert_table(albedo);
+        load(&write_scene(
+            name,
+            &toml,
+            &[("sheet.obj", obj), ("body.bsdf", &table)],
+        ))
+    };
+    let (a, b) = (scene("body-hash-a", 0.5), scene("body-hash-b", 0.6));
+    assert_eq!(a.content_hash(), scene("body-hash-a2", 0.5).content_hash());
+    assert_ne!(a.content_hash(), b.content_hash());
+    let shards: Vec<_> = [(&a, 0), (&b, 1)]
+        .into_iter()
+        .map(|(s, index)| {
+            let opts = RunOptions {
+                photons: 2000,
+                seed: 3,
+                threads: Some(1),
+                shard: Some(Shard { index, count: 2 }),
+                ..RunOptions::default()
+            };
+            let file = ShardFile::of(&support::trace_opts(s, &opts)).unwrap();
+            (format!("s{index}").into(), file)
+        })
+        .collect();
+    let e = format!("{:#}", shard::check(&shards, &a).unwrap_err());
+    assert!(e.contains("s1: scene hash is"), "{e}");
+}
+
 #[test]
 #[ignore = "slow: characterises a film and traces two stacks (about 5 s in release)"]
 fn a_table_characterised_from_a_ggx_film_traces_like_the_film() {
@@ -463,22 +576,79 @@ fn characterising_a_lambert_sheet_gives_back_its_albedo_and_shape() {
     );
 }
 
-#[test]
-fn the_bsdf_command_writes_a_table_the_model_reads() {
+/// A Lambertian sheet (tag `sheet`, facing +z) in a scene `name` for `blutrace bsdf`.
+fn bsdf_scene(name: &str) -> support::SceneDir {
     let toml = format!(
         "version = 1\n[[geometry]]\nfile = \"sheet.obj\"\n[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.6\n{LED}"
     );
     let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl sheet\nf 1 2 3\nf 1 3 4\n";
-    let scene = write_scene("bsdf-cli", &toml, &[("sheet.obj", obj)]);
-    let out = scene.parent().unwrap().join("sheet.bsdf");
-    let run = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"))
-            .arg("bsdf")
-            .arg(&*scene)
-            .args(args)
-            .output()
-            .unwrap()
+    write_scene(name, &toml, &[("sheet.obj", obj)])
+}
+
+/// `blutrace bsdf SCENE ARGS...`.
+fn bsdf_command(scene: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_blutrace"))
+        .arg("bsdf")
+        .arg(scene)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn the_bsdf_command_reads_its_u_axis_in_both_forms_and_refuses_bad_ones() {
+    let scene = bsdf_scene("bsdf-u-axis-cli");
+    let table = |name: &str, axis: &[&str]| {
+        let out = scene.parent().unwrap().join(name);
+        let mut args = vec!["--tag", "sheet", "--photons", "5000", "--aoi", "0,45"];
+        args.extend(["--out", out.to_str().unwrap()]);
+        args.extend(axis);
+        let o = bsdf_command(&scene, &args);
+        let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+        (o.status.code(), std::fs::read_to_string(&out).ok(), stderr)
     };
+    // The README's form and the spaced one give the same table; a negative first
+    // component of the comma form goes after `=` (else it reads as a flag).
+    for (name, comma, spaced) in [
+        (
+            "y",
+            &["--u-axis", "0,1,0"][..],
+            &["--u-axis", "0", "1", "0"][..],
+        ),
+        (
+            "minus-x",
+            &["--u-axis=-1,0,0"][..],
+            &["--u-axis", "-1", "0", "0"][..],
+        ),
+    ] {
+        let (a, b) = (
+            table(&format!("{name}-c"), comma),
+            table(&format!("{name}-s"), spaced),
+        );
+        assert!(a.0 == Some(0) && a.1.is_some(), "{comma:?}: {}", a.2);
+        assert_eq!(a.1, b.1, "{comma:?} and {spaced:?} differ");
+    }
+    // Not finite, zero, along the normal, or not three numbers: refused, no table.
+    for axis in [
+        &["--u-axis", "nan", "0", "0"][..],
+        &["--u-axis", "inf,0,0"][..],
+        &["--u-axis", "0", "0", "0"][..],
+        &["--u-axis", "0,0,1"][..],
+        &["--u-axis", "1,0"][..],
+    ] {
+        let (code, written, stderr) = table("bad", axis);
+        assert!(
+            code == Some(1) && written.is_none() && stderr.contains("--u-axis"),
+            "{axis:?}: {code:?} {stderr}"
+        );
+    }
+}
+
+#[test]
+fn the_bsdf_command_writes_a_table_the_model_reads() {
+    let scene = bsdf_scene("bsdf-cli");
+    let out = scene.parent().unwrap().join("sheet.bsdf");
+    let run = |args: &[&str]| bsdf_command(&scene, args);
     let o = run(&[
         "--tag",
         "sheet",

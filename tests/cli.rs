@@ -112,10 +112,25 @@ fn runs_with_nothing_detected_write_the_whole_output_set() {
             "--out",
             dir.path().join("note").to_str().unwrap(),
         ])
-        .stdout,
+        .stderr,
     )
     .to_string();
-    assert!(text.contains("no photon reached the target"), "{text}");
+    assert!(
+        text.contains("warning: no photon reached the target"),
+        "{text}"
+    );
+    // A map without light has no uniformity: null, not the 0 of a uniform map.
+    let summary = std::fs::read_to_string(dir.path().join("note/summary.json")).unwrap();
+    let s: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    for key in ["cv_debiased", "cv_noise_floor"] {
+        assert!(s[key].is_null(), "{key}: {}", s[key]);
+    }
+    assert!(s["uniformity"]["cv"].is_null(), "{}", s["uniformity"]);
+    let warnings = s["warnings"].to_string();
+    assert!(
+        warnings.contains("no photon reached the target"),
+        "{warnings}"
+    );
     // Shards of such a run merge into a complete set too.
     let shards: Vec<String> = (0..2)
         .map(|k| {

@@ -472,3 +472,86 @@ fn an_interrupted_layout_search_keeps_what_it_traced() {
     r.write(out.path()).unwrap();
     assert!(out.path().join("final/summary.json").is_file());
 }
+
+/// A 1 x 1 mm LED facing +z at height `z` under a 100 x 100 mm target at z = 0.5: lit and
+/// far from uniform below the target, unlit above it (light crossing the target from
+/// its front passes through).
+fn led_under_target(name: &str, z: f64) -> support::SceneDir {
+    let toml = format!(
+        "version = 1\ngeometry = []\nsurfaces = {{}}\n\
+         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, {z:?}]\nnormal = [0.0, 0.0, 1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = 1.0\nheight_mm = 1.0\npower_w = 1.0\n\
+         [detector]\norigin = [-50.0, -50.0, 0.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [100.0, 100.0]\nbins = [10, 10]\nangular_bins = [6, 8]\n"
+    );
+    write_scene(name, &toml, &[])
+}
+
+/// A design that puts no light on the target has no uniformity (audit 3, item 3): its
+/// objective is NaN, not the 0 of a perfectly uniform map, and neither the grid nor
+/// Nelder-Mead ever picks it, whatever the objective's terms.
+#[test]
+fn a_design_without_light_is_never_the_best() {
+    let scene = load(&led_under_target("layout-dark", 0.0));
+    for (method, objective) in [
+        (Method::Grid, "cv"),
+        (Method::Grid, "efficiency"),
+        (Method::NelderMead, "cv"),
+    ] {
+        let mut o = options(&["sources.0.center.2=-10..1"], method);
+        o.grid_points = 12;
+        o.objective = objective.parse().unwrap();
+        let r = run(&scene, &o);
+        let z = r.variables[0].final_value;
+        assert!(
+            z < 0.5,
+            "{method} {objective}: the best LED is above the target: {z}"
+        );
+        assert!(r.best.objective.is_finite() && r.best.efficiency > 0.0);
+        let dark: Vec<_> = r
+            .history
+            .iter()
+            .filter_map(|h| h.result.as_ref().filter(|e| e.efficiency == 0.0))
+            .collect();
+        if method == Method::Grid {
+            assert!(
+                !dark.is_empty(),
+                "{objective}: the grid traced no dark design"
+            );
+        }
+        assert!(
+            dark.iter()
+                .all(|e| e.objective.is_nan() && e.cv_debiased.is_nan())
+        );
+    }
+}
+
+/// Weighting the objective changes no design the simplex asks for (audit 3, item 2): a
+/// point outside the bounds ranks after every traced design whatever the objective's
+/// scale, where a fixed penalty of 1000 ranked it first under `cv=1e6`. The LED's best
+/// height lies at the range's lower end, so the simplex steps outside it.
+#[test]
+fn weighting_the_objective_leaves_the_layout_search_unchanged() {
+    let dir = led_under_target("layout-weight", 0.0);
+    let scene = load(&dir);
+    let search = |objective: &str| {
+        let mut o = options(&["sources.0.center.2=-10..0"], Method::NelderMead);
+        o.photons = 4_000;
+        o.max_iter = 15;
+        o.objective = objective.parse().unwrap();
+        run(&scene, &o)
+    };
+    let (a, b) = (search("cv=1"), search("cv=1e6"));
+    let asked = |r: &LayoutResult| -> Vec<(Vec<f64>, bool)> {
+        r.history
+            .iter()
+            .map(|h| (h.values.clone(), h.result.is_some()))
+            .collect()
+    };
+    assert!(
+        a.history.iter().any(|h| h.result.is_none()),
+        "the simplex never left the bounds"
+    );
+    assert_eq!(asked(&a), asked(&b));
+    assert_eq!(a.variables[0].final_value, b.variables[0].final_value);
+}

@@ -88,11 +88,12 @@ fn the_map_does_not_depend_on_threads_and_is_written() {
     }
 }
 
-/// A cone outside (0, 90] degrees is an error naming the field; without lumens or
-/// spectra there is no map.
+/// A cone outside [0.001, 90] degrees is an error naming the field (narrower, its solid
+/// angle is lost in rounding: 1e-300 made a map of 0/0); without lumens or spectra there
+/// is no map.
 #[test]
 fn cones_are_checked_and_a_run_without_lumens_has_no_map() {
-    for bad in ["0.0", "-1.0", "90.5", "nan"] {
+    for bad in ["0.0", "-1.0", "90.5", "nan", "1e-300", "1e-5", "0.000999"] {
         let toml = format!(
             "version = 1\ngeometry = []\nsurfaces = {{}}\n\
              [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\nu = [1.0, 0.0, 0.0]\n\
@@ -103,6 +104,7 @@ fn cones_are_checked_and_a_run_without_lumens_has_no_map() {
         let dir = write_scene("lum-bad", &toml, &[]);
         let e = format!("{:#}", blutrace::scene::Scene::load(&dir).unwrap_err());
         assert!(e.contains("detector.luminance_cone_deg"), "{bad}: {e}");
+        assert!(e.contains("[0.001, 90]") && e.len() < 400, "{bad}: {e}");
     }
     let toml = "version = 1\ngeometry = []\nsurfaces = {}\n\
         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\nu = [1.0, 0.0, 0.0]\n\
@@ -130,10 +132,32 @@ fn the_command_lines_cone_replaces_the_scenes_and_is_checked() {
     let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
     let s: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(s["luminance_map"]["cone_deg"], 10.0);
+    // No photon in the narrowest cone: the map measured nothing, and says so.
+    let empty = run(&["--luminance-cone-deg", "0.001"]);
+    let said = String::from_utf8_lossy(&empty.stdout);
+    assert!(empty.status.success(), "{said}");
+    assert!(
+        said.contains("no photon left the target within the 0.001° cone"),
+        "{said}"
+    );
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let m = &s["luminance_map"];
+    assert_eq!(m["photons_in_cone"], 0, "{m}");
+    assert!(m["mean_cd_m2"]["value"].is_null() && m["mean_cd_m2"]["stderr"].is_null());
+    // How many it would need, from the photons near the normal: more than a trillion
+    // (the cone holds 3e-10 of the light's projected solid angle).
+    let needed = m["photons_needed"].as_f64().unwrap();
+    assert!(needed > 1e12 && needed.is_finite(), "{m}");
+    assert!(said.contains("a noise floor of 0.1 needs about"), "{said}");
     for (extra, says) in [
         (
             &["--luminance-cone-deg", "95"][..],
-            "--luminance-cone-deg must be within (0, 90]",
+            "--luminance-cone-deg must be within [0.001, 90]",
+        ),
+        (
+            &["--luminance-cone-deg", "1e-300"][..],
+            "--luminance-cone-deg must be within [0.001, 90]",
         ),
         (
             &["--luminance-cone-deg", "5", "--shard", "0/2"][..],

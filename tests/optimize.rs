@@ -390,6 +390,115 @@ fn infeasible_designs_are_penalized_not_traced() {
     }
 }
 
+/// Weighting the objective changes no step of the search (audit 3, item 2): infeasible
+/// designs rank after every feasible one, not at a fixed penalty that an objective
+/// weighted by 1e6 overtakes. The first simplex leaves the printable range on purpose.
+#[test]
+fn weighting_the_objective_leaves_the_search_unchanged() {
+    let dir = small_scene("opt-weight", "density = [0.3]");
+    let scene = load(&dir);
+    let search = |objective: &str| {
+        let opts = OptimizeOptions {
+            photons: 4_000,
+            max_iter: 10,
+            initial_step: 0.5,
+            verify_photons: 0,
+            threads: Some(1),
+            objective: objective.parse().unwrap(),
+            ..OptimizeOptions::default()
+        };
+        optimize(&scene, &opts, &mut |_| {}).unwrap()
+    };
+    let (a, b) = (search("cv=1"), search("cv=1e6"));
+    let traced = a.photons as usize / 4_000;
+    assert!(a.evaluations > traced, "no design was infeasible");
+    assert_eq!(a.evaluations, b.evaluations);
+    assert_eq!(a.final_density, b.final_density);
+    let steps = |r: &blutrace::optimize::OptimizeResult| -> Vec<(String, Vec<f64>)> {
+        r.history
+            .iter()
+            .map(|h| (h.step.clone(), h.params.clone()))
+            .collect()
+    };
+    assert_eq!(steps(&a), steps(&b));
+    let rel = (b.best.objective / a.best.objective - 1e6).abs() / 1e6;
+    assert!(rel < 1e-12, "{} vs {}", a.best.objective, b.best.objective);
+}
+
+/// The constrained simplex ranks by feasibility first: the same points for an objective
+/// and for it times 1e6, infeasible ones never the best.
+#[test]
+fn nelder_mead_ranks_infeasible_points_after_feasible_ones() {
+    use nelder_mead::Cost;
+    let points = |scale: f64| {
+        let mut seen = Vec::new();
+        let out = nelder_mead::minimize_ranked(
+            &mut |x| {
+                seen.push(x.to_vec());
+                let outside = (x[0] - 1.0).max(0.0);
+                Ok(match outside > 0.0 {
+                    true => Cost::Infeasible(outside),
+                    false => Cost::Feasible(scale * ((x[0] - 3.0).powi(2) + x[1] * x[1])),
+                })
+            },
+            &[0.0, 1.0],
+            &[0.5, 0.5],
+            &Settings {
+                max_iter: 60,
+                ..Settings::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        (seen, out.x)
+    };
+    let (a, xa) = points(1.0);
+    let (b, xb) = points(1e6);
+    assert_eq!(a, b);
+    assert_eq!(xa, xb);
+    assert!((xa[0] - 1.0).abs() < 1e-3 && xa[0] <= 1.0, "{xa:?}");
+    assert!(Cost::Feasible(1e300) < Cost::Infeasible(0.0));
+    assert!(Cost::Feasible(f64::NAN) > Cost::Infeasible(1e300));
+}
+
+/// A design that puts no light on the profile has no uniformity (audit 3, item 3): no
+/// dots search takes it for the best, not even the 2-D feedback, whose debiased area cv
+/// made it 0 (perfect).
+#[test]
+fn a_dark_design_is_never_the_best_dots_design() {
+    let dir = small_scene("opt-dark", "density = [0.3]");
+    let text = std::fs::read_to_string(&*dir).unwrap();
+    std::fs::write(
+        &*dir,
+        text.replace("normal = [1.0, 0.0, 0.0]", "normal = [-1.0, 0.0, 0.0]"),
+    )
+    .unwrap();
+    let scene = load(&dir);
+    for (method, dims) in [
+        (Method::NelderMead, 1),
+        (Method::Feedback, 1),
+        (Method::Feedback, 2),
+    ] {
+        let opts = OptimizeOptions {
+            photons: 2_000,
+            max_iter: 2,
+            dims,
+            verify_photons: 0,
+            threads: Some(1),
+            method,
+            ..OptimizeOptions::default()
+        };
+        let e = match optimize(&scene, &opts, &mut |_| {}) {
+            Ok(r) => panic!(
+                "{method} {dims}-D picked a dark design: {:?}",
+                r.best.objective
+            ),
+            Err(e) => format!("{e:#}"),
+        };
+        assert!(e.contains("no feasible design"), "{method} {dims}-D: {e}");
+    }
+}
+
 /// Acceptance on notebook14 (minutes): Nelder-Mead from the constant density.
 #[test]
 #[ignore = "minutes: cargo test --release --test optimize -- --ignored"]

@@ -14,9 +14,13 @@ The same seed and photons give the same arrays bit for bit on any thread count, 
 same as the command line's ``flux.exr`` (stored there as float32).
 
 Tracing releases the GIL; Ctrl-C (``KeyboardInterrupt``) stops a trace within a second
-and raises, writing nothing. Errors are exceptions: ``SceneError`` for a scene file (the
-message names the file and the field), ``ValueError`` for a bad argument, and
-``BlutraceError`` for anything else (an internal error included).
+and raises, writing nothing; it stops ``Scene.optimize`` too, which then returns the
+outcome of the designs traced before it (``Optimization.interrupted``). Errors are
+exceptions: ``SceneError`` for a scene file (the message names the file and the field),
+``ValueError`` (a bad value) or ``TypeError`` (a wrong type) for an argument, the message
+naming it, and ``BlutraceError`` for anything else (an internal error included). Values
+of reports (``summary``, ``history``) that are undefined, such as a metric of a design
+that put no light on the target, are None, as ``null`` in the JSON files.
 """
 
 from __future__ import annotations

@@ -46,9 +46,11 @@ class Scene:
     def source(self) -> Dict[str, Any]:
         """The scene file as a dict (with any ``set`` applied)."""
     def get(self, key: str) -> Any:
-        """The value at a key path such as ``sources.0.center.2`` (``*``: every element)."""
+        """The value at a key path such as ``sources.0.center.2``; with ``*``, the value every
+        element holds, or the list of their values when they differ."""
     def set(self, key: str, value: Any) -> None:
-        """Set the value at a key path; the scene is loaded again (``SceneError`` if bad)."""
+        """Set the value at a key path (numpy arrays and scalars too); the scene is loaded
+        again (``SceneError`` if bad)."""
     def copy(self) -> Scene:
         """An independent copy."""
     def __copy__(self) -> Scene: ...
@@ -100,7 +102,8 @@ class Scene:
         export_placement: Optional[str] = ...,
         progress: _SearchProgress = ...,
     ) -> Optimization:
-        """Optimize the dot density, or with ``vary`` the numbers its key paths name."""
+        """Optimize the dot density, or with ``vary`` the numbers its key paths name; Ctrl-C
+        returns the designs traced so far (``interrupted`` True)."""
     def characterise(
         self,
         tag: str,

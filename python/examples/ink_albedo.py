@@ -41,10 +41,9 @@ def main(argv: list[str] | None = None) -> int:
         design.set(key, albedo)
         run = design.trace(photons=a.photons, seed=1)
         eff, err = run.efficiency
-        print(
-            f"{albedo:6.2f}  {eff:10.4f}  {err:.4f}  {run.summary['cv_debiased']:11.4f}"
-            f"  {run.flux.mean():.4e}"
-        )
+        cv = run.summary["cv_debiased"]
+        cv = float("nan") if cv is None else cv  # None: no light on the target
+        print(f"{albedo:6.2f}  {eff:10.4f}  {err:.4f}  {cv:11.4f}  {run.flux.mean():.4e}")
     return 0
 
 

@@ -38,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
         run = design.trace(photons=a.photons, seed=1)
         eff, err = run.efficiency
         cv = run.summary["cv_debiased"]
+        cv = float("nan") if cv is None else cv  # None: no light on the target
         rows.append((h, cv, eff, err))
         print(f"{h:9.2f}  {cv:11.4f}  {eff:10.4f}  {err:.4f}")
 

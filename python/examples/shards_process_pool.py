@@ -50,8 +50,10 @@ def main(argv: list[str] | None = None) -> int:
         merged.angular, single.angular
     )
     eff, err = merged.efficiency
+    cv = merged.summary["cv_debiased"]
+    cv = float("nan") if cv is None else cv  # None: no light on the target
     print(f"{scene.name}: {a.shards} shards of {photons} photons merged")
-    print(f"efficiency {eff:.4f} +- {err:.4f}, debiased cv {merged.summary['cv_debiased']:.4f}")
+    print(f"efficiency {eff:.4f} +- {err:.4f}, debiased cv {cv:.4f}")
     print(f"merged == single run, bit for bit: {identical}")
     if a.out:
         for f in merged.write(a.out):

@@ -3,7 +3,7 @@
 //! bsdf` runs it): the part found, the fates per incidence as numpy arrays, and the table
 //! as text or written to a file.
 
-use crate::convert::{count, run_error};
+use crate::convert::{arg, count, run_error};
 use crate::detached::run_detached;
 use crate::progress;
 use blutrace::characterise::{Characterised, Fates, Options, characterise_until};
@@ -76,7 +76,11 @@ impl Characterisation {
     }
 
     /// Write the table to ``path`` (a ``.bsdf`` file), whole or not at all.
-    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::path_arg)] path: PathBuf,
+    ) -> PyResult<()> {
         let text = self.to_bsdf();
         py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes(), &self.reads))
             .map_err(run_error)
@@ -111,6 +115,7 @@ pub fn characterise_scene(
     scene: &RustScene,
     args: Args<'_, '_>,
 ) -> PyResult<Characterisation> {
+    crate::scene::tag_arg(scene, args.tag)?;
     let photons = args
         .photons
         .map_or(Ok(1_000_000), |p| count(p, "photons", 1))?;
@@ -163,4 +168,14 @@ pub fn characterise_scene(
         comments,
         reads: scene.inputs.clone(),
     })
+}
+
+/// Argument `radial_step` (degrees).
+pub fn radial_step(v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    arg(v, "radial_step")
+}
+
+/// Argument `azimuth_step` (degrees).
+pub fn azimuth_step(v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    arg(v, "azimuth_step")
 }

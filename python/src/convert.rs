@@ -10,6 +10,7 @@ use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::PathBuf;
 
 /// A TOML value as a Python object (tables are dicts, arrays lists, datetimes strings).
 pub fn toml_to_py<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, PyAny>> {
@@ -36,8 +37,8 @@ pub fn toml_to_py<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, 
     })
 }
 
-/// A Python value as TOML: bool, int, float (numpy scalars too), str, list or tuple,
-/// dict with str keys; anything else is a `TypeError`.
+/// A Python value as TOML: bool, int, float, str, list or tuple, dict with str keys, numpy
+/// arrays and scalars (as their `tolist()`); anything else is a `TypeError`.
 pub fn py_to_toml(v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     if v.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(v.extract()?));
@@ -72,7 +73,18 @@ pub fn py_to_toml(v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         }
         return Ok(toml::Value::Table(t));
     }
-    // numpy scalars and other numbers: integers through __index__, else a float.
+    // numpy arrays and scalars: their Python values (nested lists, bool, int, float).
+    if v.hasattr("tolist")? {
+        let plain = v.call_method0("tolist")?;
+        if plain.hasattr("tolist")? {
+            return Err(PyTypeError::new_err(format!(
+                "cannot write a {} into a scene file (its tolist() is no list or number)",
+                v.get_type().name()?
+            )));
+        }
+        return py_to_toml(&plain);
+    }
+    // Other numbers: integers through __index__, else a float.
     if v.hasattr("__index__")? {
         return Ok(toml::Value::Integer(
             v.call_method0("__index__")?.extract()?,
@@ -166,19 +178,60 @@ pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64) -> PyResult<u64> {
     Ok(n)
 }
 
+/// Argument `name` as a `T`; a value of the wrong type or shape raises the exception it
+/// would (`TypeError`, `ValueError`), its message naming the argument.
+pub fn arg<'a, 'py, T>(v: &'a Bound<'py, PyAny>, name: &str) -> PyResult<T>
+where
+    T: FromPyObject<'a, 'py>,
+    T::Error: Into<PyErr>,
+{
+    v.extract::<T>().map_err(|e| named(v.py(), name, e.into()))
+}
+
+/// Argument `path`: a file's path (str or path-like).
+pub fn path_arg(v: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    arg(v, "path")
+}
+
+/// Argument `dir`: a folder's path (str or path-like).
+pub fn dir_arg(v: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    arg(v, "dir")
+}
+
+/// `e` with its message prefixed by the argument it is about, its type kept.
+pub fn named(py: Python<'_>, name: &str, e: PyErr) -> PyErr {
+    PyErr::from_type(e.get_type(py), format!("{name}: {}", e.value(py)))
+}
+
 /// One of `choices` (spelling, value), or a `ValueError` listing them.
-pub fn choice<T: Copy>(name: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    choices
-        .iter()
-        .find(|(s, _)| *s == given)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<String> = choices.iter().map(|(s, _)| format!("'{s}'")).collect();
-            PyValueError::new_err(format!(
-                "{name} must be one of {}, got '{given}'",
-                names.join(", ")
-            ))
-        })
+pub fn choice<T: Copy>(name: &str, given: &str, choices: &[(&'static str, T)]) -> PyResult<T> {
+    lookup(name, given, choices).map(|(_, v)| *v)
+}
+
+/// Argument `name`, a str naming one of `choices`, as the table spells it: a `&'static
+/// str`, so a signature keeps its literal default (`from_py_with` of a spelling argument).
+pub fn spelling<T>(
+    v: &Bound<'_, PyAny>,
+    name: &str,
+    choices: &[(&'static str, T)],
+) -> PyResult<&'static str> {
+    let given: String = arg(v, name)?;
+    lookup(name, &given, choices).map(|(s, _)| *s)
+}
+
+/// The entry of `choices` spelled `given`, or a `ValueError` listing them.
+fn lookup<'c, T>(
+    name: &str,
+    given: &str,
+    choices: &'c [(&'static str, T)],
+) -> PyResult<&'c (&'static str, T)> {
+    choices.iter().find(|(s, _)| *s == given).ok_or_else(|| {
+        let names: Vec<String> = choices.iter().map(|(s, _)| format!("'{s}'")).collect();
+        PyValueError::new_err(format!(
+            "{name} must be one of {}, got '{given}'",
+            names.join(", ")
+        ))
+    })
 }
 
 /// A scene error (loading, editing): `SceneError` with the file and field in its message.

@@ -19,8 +19,32 @@ pub fn run_detached<T: Send>(
     py: Python<'_>,
     interrupt: &Interrupt,
     work: impl FnOnce() -> anyhow::Result<T> + Send,
-    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
+    tick: impl FnMut(Python<'_>) -> PyResult<()>,
 ) -> PyResult<anyhow::Result<T>> {
+    let waited = wait_detached(py, interrupt, work, tick);
+    if let Some(e) = waited.stopped {
+        return Err(e);
+    }
+    waited.outcome
+}
+
+/// What [`wait_detached`] saw: the exception that stopped the wait, if any, and what the
+/// work returned after it (a panic as a `BlutraceError`).
+pub struct Waited<T> {
+    /// Ctrl-C's `KeyboardInterrupt`, or an exception of `tick`.
+    pub stopped: Option<PyErr>,
+    /// The work's result.
+    pub outcome: PyResult<anyhow::Result<T>>,
+}
+
+/// [`run_detached`] that keeps the work's result when an exception stopped the wait: for
+/// work that, interrupted, still has something to return (a search's designs so far).
+pub fn wait_detached<T: Send>(
+    py: Python<'_>,
+    interrupt: &Interrupt,
+    work: impl FnOnce() -> anyhow::Result<T> + Send,
+    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
+) -> Waited<T> {
     std::thread::scope(|s| {
         let handle = s.spawn(work);
         let waited: PyResult<()> = loop {
@@ -41,8 +65,7 @@ pub fn run_detached<T: Send>(
             interrupt.request();
         }
         let joined = py.detach(|| handle.join());
-        waited?;
-        joined.map_err(|payload| {
+        let outcome = joined.map_err(|payload| {
             let what = payload
                 .downcast_ref::<&str>()
                 .map(|s| s.to_string())
@@ -51,7 +74,11 @@ pub fn run_detached<T: Send>(
             BlutraceError::new_err(format!(
                 "internal error (a bug in blutrace; please report it): {what}"
             ))
-        })
+        });
+        Waited {
+            stopped: waited.err(),
+            outcome,
+        }
     })
 }
 

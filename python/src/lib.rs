@@ -21,14 +21,16 @@ mod scene;
 use pyo3::create_exception;
 use pyo3::prelude::*;
 
+// The exceptions are `blutrace.BlutraceError` and `blutrace.SceneError` (their module is the
+// package users import, not the extension module inside it), as tracebacks print them.
 create_exception!(
-    _native,
+    blutrace,
     BlutraceError,
     pyo3::exceptions::PyException,
     "Base class of blutrace's errors (a run or a write that failed, an internal error)."
 );
 create_exception!(
-    _native,
+    blutrace,
     SceneError,
     BlutraceError,
     "A scene file, or a file it names, is wrong: the message names the file and the field."

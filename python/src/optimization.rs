@@ -2,10 +2,9 @@
 //! (Nelder-Mead, feedback) and, with `vary`, the search over numbers of the scene file,
 //! with the command line's options as keywords.
 
-use crate::BlutraceError;
-use crate::convert::{choice, count, run_error, serialized};
-use crate::detached::{detached, run_detached};
-use crate::scene::{BACKENDS, ESTIMATORS, Scene, threads_arg};
+use crate::convert::{arg, choice, count, run_error, serialized};
+use crate::detached::{Waited, detached, wait_detached};
+use crate::scene::{BACKENDS, ESTIMATORS, Scene, tag_arg, threads_arg};
 use blutrace::optics::dots::Placement;
 use blutrace::optimize::ObjectiveSpec;
 use blutrace::optimize::layout::VarySpec;
@@ -13,7 +12,7 @@ use blutrace::optimize::{
     LayoutResult, Method, OptimizeOptions, OptimizeResult, optimize, optimize_layout,
 };
 use blutrace::scene::Scene as RustScene;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -37,7 +36,9 @@ enum Outcome {
 ///
 /// ``scene`` is the optimized scene (``optimized.toml``), ``history`` one dict per iteration
 /// or evaluated design, ``summary`` the content of ``optimize.json``, ``interrupted`` whether
-/// Ctrl-C ended the search early; ``write(dir)`` writes what ``blutrace optimize`` writes.
+/// Ctrl-C ended the search early (the outcome is then that of the designs traced before
+/// it); ``write(dir)`` writes what ``blutrace optimize`` writes. A value the search could
+/// not define (a metric of a design that put no light on the target) is None.
 #[pyclass(module = "blutrace", name = "Optimization", frozen)]
 pub struct Optimization {
     outcome: Arc<Outcome>,
@@ -82,7 +83,11 @@ impl Optimization {
 
     /// Write what `blutrace optimize` writes into `dir`, all or nothing; returns the files
     /// and folders written.
-    fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<String>> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::dir_arg)] dir: PathBuf,
+    ) -> PyResult<Vec<String>> {
         let outcome = self.outcome.clone();
         let files = detached(py, || match &*outcome {
             Outcome::Density(r) => r.write(&dir),
@@ -117,7 +122,7 @@ pub fn optimize_scene(
     o.seed = scene.default_seed;
     if let Some(vary) = vary {
         for (key, range) in vary.iter() {
-            let key: String = key.extract()?;
+            let key: String = arg(&key, "vary keys")?;
             let (lo, hi): (f64, f64) = range.extract().map_err(|_| {
                 PyValueError::new_err(format!("vary[{key:?}] must be a (min, max) pair"))
             })?;
@@ -133,6 +138,10 @@ pub fn optimize_scene(
             let k: String = k.extract()?;
             set_option(&mut o, &k, &v, &mut progress)?;
         }
+    }
+    // A tag the scene lacks is the same ValueError as `characterise`'s.
+    if let Some(tag) = &o.tag {
+        tag_arg(scene, tag)?;
     }
     let reporter = crate::progress::reporter(py, progress.as_ref(), 0)?;
     let (tx, rx) = mpsc::channel::<(String, serde_json::Value)>();
@@ -167,11 +176,16 @@ pub fn optimize_scene(
         }
         Ok(())
     };
-    let searched = run_detached(py, &o.interrupt, work, drain);
+    let Waited { stopped, outcome } = wait_detached(py, &o.interrupt, work, drain);
+    // Ctrl-C: the search returns the designs traced before it, as the CLI writes them.
+    let found = matches!(outcome, Ok(Ok(_)));
+    if let Some(e) = stopped.filter(|e| !(found && e.is_instance_of::<PyKeyboardInterrupt>(py))) {
+        return Err(e);
+    }
     drain(py)?;
-    let outcome = searched?.map_err(|e| {
+    let outcome = outcome?.map_err(|e| {
         if blutrace::run::is_interrupted(&e) {
-            BlutraceError::new_err("interrupted before the first design was traced")
+            PyKeyboardInterrupt::new_err("interrupted before the first design was traced")
         } else {
             run_error(e)
         }
@@ -181,7 +195,7 @@ pub fn optimize_scene(
         Outcome::Layout(r) => r.optimized_toml(),
     }
     .map_err(run_error)?;
-    let optimized = Scene::from_toml(py, &toml_text, scene.path.clone())?;
+    let optimized = Scene::from_toml(py, toml_text, scene.path.clone())?;
     Ok(Optimization {
         outcome: Arc::new(outcome),
         scene: optimized,
@@ -203,7 +217,7 @@ fn set_option<'py>(
     match key {
         "progress" => *progress = opt(v).then(|| v.clone()),
         "objective" => {
-            let s: String = v.extract()?;
+            let s: String = arg(v, key)?;
             o.objective = s.parse::<ObjectiveSpec>().map_err(PyValueError::new_err)?;
         }
         "grid_points" => o.grid_points = count(v, key, 2)? as usize,
@@ -219,13 +233,13 @@ fn set_option<'py>(
         }
         "min_density" => o.min_density = f(key)?,
         "max_density" => o.max_density = opt(v).then(|| f(key)).transpose()?,
-        "tag" => o.tag = opt(v).then(|| v.extract()).transpose()?,
+        "tag" => o.tag = opt(v).then(|| arg(v, key)).transpose()?,
         "initial_step" => o.initial_step = f(key)?,
         "simplex_tol" => o.simplex_tol = f(key)?,
         "alpha" => o.alpha = f(key)?,
         "smoothing" => o.smoothing = f(key)?,
         "dims" => o.dims = count(v, key, 1)? as usize,
-        "cells" => o.cells = opt(v).then(|| v.extract::<(usize, usize)>()).transpose()?,
+        "cells" => o.cells = opt(v).then(|| arg(v, key)).transpose()?,
         "strips" => {
             o.strips = opt(v)
                 .then(|| count(v, key, 1))
@@ -236,11 +250,11 @@ fn set_option<'py>(
         "verify_photons" => o.verify_photons = count(v, key, 0)?,
         "verify_seed" => o.verify_seed = opt(v).then(|| count(v, key, 0)).transpose()?,
         "threads" => o.threads = opt(v).then(|| threads_arg(v)).transpose()?,
-        "estimator" => o.estimator = choice(key, &v.extract::<String>()?, ESTIMATORS)?,
-        "backend" => o.backend = choice(key, &v.extract::<String>()?, BACKENDS)?,
+        "estimator" => o.estimator = choice(key, &arg::<String>(v, key)?, ESTIMATORS)?,
+        "backend" => o.backend = choice(key, &arg::<String>(v, key)?, BACKENDS)?,
         "export_placement" => {
             o.export_placement = if opt(v) {
-                let name: String = v.extract()?;
+                let name: String = arg(v, key)?;
                 let printable: Vec<(&str, Placement)> = Placement::ALL
                     .iter()
                     .copied()

@@ -143,7 +143,11 @@ impl Run {
     /// `conoscope.png`, `convergence.csv`, `convergence.png`, `summary.json`, and the
     /// colour images of a spectral scene) into `dir`, all or nothing;
     /// returns the files written.
-    fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<String>> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::dir_arg)] dir: PathBuf,
+    ) -> PyResult<Vec<String>> {
         let run = self.inner.clone();
         let files = detached(py, || run.write(&dir))?.map_err(run_error)?;
         Ok(files.iter().map(|f| f.display().to_string()).collect())
@@ -199,7 +203,11 @@ impl Run {
 /// unless `partial`.
 #[pyfunction]
 #[pyo3(signature = (runs, partial=false))]
-pub fn merge(py: Python<'_>, runs: Vec<Bound<'_, Run>>, partial: bool) -> PyResult<Run> {
+pub fn merge(
+    py: Python<'_>,
+    #[pyo3(from_py_with = runs_arg)] runs: Vec<Bound<'_, Run>>,
+    #[pyo3(from_py_with = partial_arg)] partial: bool,
+) -> PyResult<Run> {
     let Some(first) = runs.first() else {
         return Err(PyValueError::new_err("merge needs at least one shard run"));
     };
@@ -227,11 +235,24 @@ pub fn merge(py: Python<'_>, runs: Vec<Bound<'_, Run>>, partial: bool) -> PyResu
     Ok(Run::new(merged))
 }
 
+/// Argument `runs` of `merge`: a sequence of `Run`s.
+fn runs_arg<'py>(v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, Run>>> {
+    crate::convert::arg(v, "runs")
+}
+
+/// Argument `partial` of `merge`: a bool.
+fn partial_arg(v: &Bound<'_, PyAny>) -> PyResult<bool> {
+    crate::convert::arg(v, "partial")
+}
+
 /// The channels of an OpenEXR image written by blutrace (`flux.exr`, `angular.exr`), as
 /// float32 arrays `(ny, nx)` by channel name (`Y`, `stderr.Y`, `hits.Y`, ...), rows as
 /// in `Run.flux` (row 0 at the detector's origin).
 #[pyfunction]
-pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+pub fn read_exr<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = crate::convert::path_arg)] path: PathBuf,
+) -> PyResult<Bound<'py, PyDict>> {
     let (width, height, channels, _attributes) =
         detached(py, || blutrace::output::exr::read_channels(&path))?
             .map_err(|e| BlutraceError::new_err(format!("{e:#}")))?;

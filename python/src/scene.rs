@@ -2,7 +2,9 @@
 //! and the calls that use it: check, trace, optimize, characterise.
 
 use crate::characterisation::{self, Characterisation};
-use crate::convert::{self, choice, count, py_to_toml, run_error, scene_error, toml_to_py};
+use crate::convert::{
+    self, arg, choice, count, py_to_toml, run_error, scene_error, spelling, toml_to_py,
+};
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
 use crate::progress;
@@ -48,9 +50,10 @@ const TARGET_METRICS: &[(&str, TargetMetric)] = &[
 /// names; ``Scene.from_toml(text, path)`` builds one from text (geometry relative to
 /// ``path``'s folder). ``get(key)`` and ``set(key, value)`` read and change the scene file's
 /// values by key path: dotted keys and array indices from 0 (``sources.0.center.2``), ``*``
-/// for every element of an array (``sources.*.center.2``); ``set`` loads the scene again
-/// from the edited file, so every check runs. ``check()`` returns what ``blutrace check
-/// --json`` prints.
+/// for every element of an array (``sources.*.center.2``: ``get`` gives their one value, or
+/// the list of their values when they differ); ``set`` takes numbers, str, lists, dicts and
+/// numpy arrays and scalars, and loads the scene again from the edited file, so every
+/// check runs. ``check()`` returns what ``blutrace check --json`` prints.
 #[pyclass(module = "blutrace", name = "Scene")]
 #[derive(Clone)]
 pub struct Scene {
@@ -71,7 +74,10 @@ fn scene_file(p: &Path) -> PathBuf {
 impl Scene {
     /// Load and validate a scene: a scene file or a folder holding `scene.toml`.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
+    fn load(
+        py: Python<'_>,
+        #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
+    ) -> PyResult<Scene> {
         let file = scene_file(&path);
         let scene = detached(py, || RustScene::load(&file))?.map_err(scene_error)?;
         Ok(Scene {
@@ -82,8 +88,12 @@ impl Scene {
     /// A scene from the text of a scene file; its geometry paths are relative to `path`'s
     /// folder (the file it stands for).
     #[staticmethod]
-    pub fn from_toml(py: Python<'_>, text: &str, path: PathBuf) -> PyResult<Scene> {
-        let doc: toml::Value = toml::from_str(text)
+    pub fn from_toml(
+        py: Python<'_>,
+        #[pyo3(from_py_with = text_arg)] text: String,
+        #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
+    ) -> PyResult<Scene> {
+        let doc: toml::Value = toml::from_str(&text)
             .map_err(|e| scene_error(anyhow::anyhow!("{}: {e}", path.display())))?;
         let scene = detached(py, || RustScene::from_source(doc, &path))?.map_err(scene_error)?;
         Ok(Scene {
@@ -132,25 +142,40 @@ impl Scene {
         format!("{:016x}", self.inner.content_hash())
     }
 
-    /// The value at a key path such as `sources.0.center.2` (`*` for every element of an
-    /// array, which must then all hold the same value).
-    fn get<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-        let v = self
-            .inner
-            .get(key)
-            .map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
-        toml_to_py(py, &v)
+    /// The value at a key path such as `sources.0.center.2`; with `*` for every element of
+    /// an array, the one value they all hold, or the list of their values (in order) when
+    /// they differ.
+    fn get<'py>(&self, py: Python<'py>, key: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let key: String = arg(key, "key")?;
+        let doc = self.inner.source();
+        let places = key_path::resolve(doc, &key).map_err(|e| {
+            PyValueError::new_err(format!("{}: {key}: {e:#}", self.inner.path.display()))
+        })?;
+        let values: Vec<toml::Value> = places
+            .iter()
+            .map(|p| key_path::get(doc, p).clone())
+            .collect();
+        match &values[..] {
+            [first, rest @ ..] if rest.iter().all(|v| v == first) => toml_to_py(py, first),
+            _ => toml_to_py(py, &toml::Value::Array(values)),
+        }
     }
 
     /// Set the value at a key path (every element a `*` names): the scene is loaded again
     /// from the edited file, so every check runs (a `SceneError` leaves it unchanged).
-    fn set(&mut self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let value = py_to_toml(value)?;
-        key_path::resolve(self.inner.source(), key).map_err(|e| {
+    fn set(
+        &mut self,
+        py: Python<'_>,
+        key: &Bound<'_, PyAny>,
+        value: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let key: String = arg(key, "key")?;
+        let value = py_to_toml(value).map_err(|e| convert::named(py, &key, e))?;
+        key_path::resolve(self.inner.source(), &key).map_err(|e| {
             PyValueError::new_err(format!("{}: {key}: {e:#}", self.inner.path.display()))
         })?;
         let scene = self.inner.clone();
-        let edited = detached(py, || scene.with(key, value))?.map_err(scene_error)?;
+        let edited = detached(py, || scene.with(&key, value))?.map_err(scene_error)?;
         self.inner = Arc::new(edited);
         Ok(())
     }
@@ -205,14 +230,16 @@ impl Scene {
         photons: Option<&Bound<'_, PyAny>>,
         seed: Option<&Bound<'_, PyAny>>,
         threads: Option<&Bound<'_, PyAny>>,
-        estimator: &str,
-        target_error: Option<f64>,
-        target_metric: &str,
-        max_time: Option<f64>,
+        #[pyo3(from_py_with = estimator_arg)] estimator: &str,
+        target_error: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = target_metric_arg)] target_metric: &str,
+        max_time: Option<&Bound<'_, PyAny>>,
         progress: Option<&Bound<'_, PyAny>>,
-        shard: Option<(i64, i64)>,
-        backend: &str,
+        shard: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = backend_arg)] backend: &str,
     ) -> PyResult<Run> {
+        let target_error: Option<f64> = target_error.map(|v| arg(v, "target_error")).transpose()?;
+        let max_time: Option<f64> = max_time.map(|v| arg(v, "max_time")).transpose()?;
         let open_ended = target_error.is_some() || max_time.is_some();
         let photons = match photons {
             Some(p) => count(p, "photons", 1)?,
@@ -265,14 +292,19 @@ impl Scene {
     /// ``strips``, ``edge_margin_mm``, ``verify_photons`` (1e7; 0 for none), ``verify_seed``,
     /// ``threads``, ``estimator``, ``backend``, ``export_placement``; ``progress`` is True (one
     /// line per iteration on stderr) or a callable taking each iteration's record (a dict).
+    /// Ctrl-C stops the search: it returns the outcome of the designs traced before it, with
+    /// ``interrupted`` True (before the first design, ``KeyboardInterrupt`` is raised).
     #[pyo3(signature = (method=None, vary=None, **options))]
     fn optimize(
         &self,
         py: Python<'_>,
-        method: Option<&str>,
-        vary: Option<&Bound<'_, PyDict>>,
+        method: Option<&Bound<'_, PyAny>>,
+        vary: Option<&Bound<'_, PyAny>>,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Optimization> {
+        let method: Option<String> = method.map(|m| arg(m, "method")).transpose()?;
+        let vary: Option<Bound<'_, PyDict>> = vary.map(|v| arg(v, "vary")).transpose()?;
+        let (method, vary) = (method.as_deref(), vary.as_ref());
         optimization::optimize_scene(py, &self.inner, method, vary, options)
     }
 
@@ -284,32 +316,37 @@ impl Scene {
     /// ``radial_step`` and ``azimuth_step`` the table's cells (2 and 10 degrees),
     /// ``u_axis`` the direction of rotation 0 on the face, ``seed`` (1); ``progress`` as
     /// ``trace``'s, over the photons of all incidences (reported an incidence at a time).
-    /// Releases the GIL; Ctrl-C stops it before the next incidence. A bad argument or a
-    /// part that is not one flat face raises ``ValueError``.
+    /// Releases the GIL; Ctrl-C stops it before the next incidence. A bad argument (an
+    /// unknown tag included) or a part that is not one flat face raises ``ValueError``, an
+    /// argument of a wrong type ``TypeError``.
     #[pyo3(signature = (tag, photons=None, aoi=None, rotations=None, radial_step=2.0,
         azimuth_step=10.0, u_axis=None, seed=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn characterise(
         &self,
         py: Python<'_>,
-        tag: &str,
+        tag: &Bound<'_, PyAny>,
         photons: Option<&Bound<'_, PyAny>>,
-        aoi: Option<Vec<f64>>,
-        rotations: Option<Vec<f64>>,
-        radial_step: f64,
-        azimuth_step: f64,
-        u_axis: Option<[f64; 3]>,
+        aoi: Option<&Bound<'_, PyAny>>,
+        rotations: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = characterisation::radial_step)] radial_step: f64,
+        #[pyo3(from_py_with = characterisation::azimuth_step)] azimuth_step: f64,
+        u_axis: Option<&Bound<'_, PyAny>>,
         seed: Option<&Bound<'_, PyAny>>,
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Characterisation> {
+        let tag: String = arg(tag, "tag")?;
         let args = characterisation::Args {
-            tag,
+            tag: &tag,
             photons,
-            aoi: aoi.unwrap_or_else(|| blutrace::characterise::DEFAULT_AOI_DEG.to_vec()),
-            rotations: rotations.unwrap_or_else(|| vec![0.0]),
+            aoi: aoi.map_or_else(
+                || Ok(blutrace::characterise::DEFAULT_AOI_DEG.to_vec()),
+                |v| arg(v, "aoi"),
+            )?,
+            rotations: rotations.map_or_else(|| Ok(vec![0.0]), |v| arg(v, "rotations"))?,
             radial_step,
             azimuth_step,
-            u_axis,
+            u_axis: u_axis.map(|v| arg(v, "u_axis")).transpose()?,
             seed,
             progress,
         };
@@ -336,13 +373,38 @@ impl Scene {
     }
 }
 
+/// Argument `text` of `from_toml`: a scene file's text.
+fn text_arg(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    arg(v, "text")
+}
+
+/// Argument `estimator`: one of [`ESTIMATORS`].
+fn estimator_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "estimator", ESTIMATORS)
+}
+
+/// Argument `target_metric`: one of [`TARGET_METRICS`].
+fn target_metric_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "target_metric", TARGET_METRICS)
+}
+
+/// Argument `backend`: one of [`BACKENDS`].
+fn backend_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "backend", BACKENDS)
+}
+
 /// `shard=(k, m)` checked: 0 <= k < m <= MAX_SHARDS.
-fn shard_arg((index, count): (i64, i64)) -> PyResult<Shard> {
+fn shard_arg(v: &Bound<'_, PyAny>) -> PyResult<Shard> {
+    let bad = || {
+        PyValueError::new_err(format!(
+            "shard must be (k, m) with 0 <= k < m <= {}, got {}",
+            run::MAX_SHARDS,
+            v.repr().map_or("?".into(), |r| r.to_string())
+        ))
+    };
+    let (index, count): (i64, i64) = v.extract().map_err(|_| bad())?;
     if !(0 <= index && index < count && count as u64 <= run::MAX_SHARDS) {
-        return Err(PyValueError::new_err(format!(
-            "shard must be (k, m) with 0 <= k < m <= {}, got ({index}, {count})",
-            run::MAX_SHARDS
-        )));
+        return Err(bad());
     }
     Ok(Shard {
         index: index as u64,
@@ -360,4 +422,16 @@ pub fn threads_arg(t: &Bound<'_, PyAny>) -> PyResult<usize> {
         )));
     }
     Ok(n as usize)
+}
+
+/// Argument `tag` checked: the index of a tag of `scene`, else a `ValueError` listing them
+/// (the same for every call that names a part by its tag).
+pub fn tag_arg(scene: &RustScene, tag: &str) -> PyResult<usize> {
+    scene.tags.iter().position(|t| t == tag).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "tag: no tag '{tag}' in {} (its tags: {})",
+            scene.path.display(),
+            scene.tags.join(", ")
+        ))
+    })
 }

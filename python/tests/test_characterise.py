@@ -66,17 +66,46 @@ def test_the_written_table_is_a_bsdf_table_face(sheet, tmp_path):
     assert abs(a - b) < 4 * np.sqrt(2 * a * (1 - a) / 200_000), (a, b)
 
 
+def test_nothing_is_written_over_a_file_the_scene_reads(sheet, tmp_path):
+    c = sheet.characterise("sheet", photons=1000, aoi=[0])
+    mesh = tmp_path / "sheet.obj"
+    with pytest.raises(bt.BlutraceError, match="an input of this run"):
+        c.write(mesh)
+    run = sheet.trace(photons=1000, seed=1)
+    with pytest.raises(bt.BlutraceError, match="sheet.obj"):
+        run.write(tmp_path)
+    assert mesh.read_text() == OBJ
+
+
 @pytest.mark.parametrize(
     "kwargs, says",
     [
         ({"tag": "nothing"}, "nothing"),
         ({"tag": "sheet", "aoi": [0, 95]}, "95"),
         ({"tag": "sheet", "photons": 0}, "photons"),
+        ({"tag": "sheet", "u_axis": (1.0, 0.0)}, "u_axis"),
     ],
 )
 def test_a_bad_argument_is_a_value_error_naming_it(sheet, kwargs, says):
-    with pytest.raises(ValueError, match=says):
+    with pytest.raises(ValueError) as e:
         sheet.characterise(**kwargs)
+    assert says in str(e.value)  # the message itself, not a note pytest's match= also reads
+
+
+@pytest.mark.parametrize(
+    "kwargs, says",
+    [
+        ({"radial_step": "fine"}, "radial_step"),
+        ({"azimuth_step": None}, "azimuth_step"),
+        ({"aoi": [0, "x"]}, "aoi"),
+        ({"rotations": 90.0}, "rotations"),
+        ({"u_axis": 5}, "u_axis"),
+    ],
+)
+def test_an_argument_of_a_wrong_type_is_a_type_error_naming_it(sheet, kwargs, says):
+    with pytest.raises(TypeError) as e:
+        sheet.characterise("sheet", **kwargs)
+    assert says in str(e.value)  # the message itself, not a note pytest's match= also reads
 
 
 def test_progress_hears_the_photons_of_every_incidence(sheet):

@@ -48,8 +48,26 @@ def test_a_grid_over_a_key_path_traces_each_value(phone, capsys):
         ({"vary": {"sources.0.center.2": (5, 1)}}, ValueError, "empty or inverted"),
         ({"vary": {"sources.0.center.2": 3}}, ValueError, "pair"),
         ({"photons": 0}, ValueError, "photons"),
+        ({"tag": "nope"}, ValueError, "tag: no tag 'nope'"),
+        ({"tag": "led_housing"}, ValueError, "option `tag`: surface 'led_housing' is not"),
+        ({"tag": 5}, TypeError, "tag"),
+        ({"cells": (4,)}, ValueError, "cells"),
+        ({"estimator": 1}, TypeError, "estimator"),
+        ({"objective": 2}, TypeError, "objective"),
+        ({"vary": {3: (0.0, 1.0)}}, TypeError, "vary"),
     ],
 )
 def test_bad_optimize_arguments_are_errors_naming_them(phone, kwargs, error, says):
-    with pytest.raises(error, match=says):
+    with pytest.raises(error) as e:
         phone.optimize(**{"verify_photons": 0, **kwargs})
+    assert says in str(e.value)  # the message itself, not a note pytest's match= also reads
+
+
+def test_an_unknown_tag_is_the_same_value_error_everywhere(phone):
+    with pytest.raises(ValueError) as by_optimize:
+        phone.optimize(tag="nope", verify_photons=0)
+    with pytest.raises(ValueError) as by_characterise:
+        phone.characterise("nope")
+    assert type(by_optimize.value) is type(by_characterise.value) is ValueError
+    assert str(by_optimize.value) == str(by_characterise.value)
+    assert str(by_optimize.value).startswith("tag: no tag 'nope' in ")

@@ -6,6 +6,7 @@ import copy
 import json
 import pickle
 
+import numpy as np
 import pytest
 
 import blutrace as bt
@@ -29,10 +30,13 @@ def test_get_reads_numbers_arrays_and_tables(box):
     assert box.get("detector.bins") == list(box.source["detector"]["bins"])
 
 
-def test_a_star_reads_the_value_every_element_holds(phone):
+def test_a_star_reads_the_value_every_element_holds_or_each_value(phone):
     assert phone.get("sources.*.center.2") == phone.get("sources.0.center.2")
-    with pytest.raises(ValueError, match="the elements differ"):
-        phone.get("sources.*.center.1")  # the LEDs sit at different y
+    # The LEDs sit at different y: one value per element, in order.
+    ys = [src["center"][1] for src in phone.source["sources"]]
+    assert len(set(ys)) > 1
+    assert phone.get("sources.*.center.1") == ys
+    assert phone.get("sources.*.center") == [src["center"] for src in phone.source["sources"]]
 
 
 def test_set_changes_the_scene_and_copies_are_independent(phone):
@@ -69,9 +73,37 @@ def test_set_of_an_invalid_value_is_a_scene_error_naming_file_and_field(phone):
     assert s.get("surfaces.lgp_back.ink_albedo") == 0.9
 
 
-def test_set_of_a_value_toml_cannot_hold_is_a_type_error(box):
-    with pytest.raises(TypeError):
+def test_set_of_a_value_toml_cannot_hold_is_a_type_error_naming_the_key(box):
+    with pytest.raises(TypeError, match="trace.seed"):
         box.copy().set("trace.seed", object())
+
+
+def test_set_takes_numpy_arrays_and_scalars(phone):
+    s = phone.copy()
+    s.set("sources.0.center", np.array([1.0, 2.0, 3.0]))
+    assert s.get("sources.0.center") == [1.0, 2.0, 3.0]
+    s.set("surfaces.lgp_back.ink_albedo", np.float64(0.5))
+    assert s.get("surfaces.lgp_back.ink_albedo") == 0.5
+    s.set("surfaces.lgp_back.ink_albedo", np.float32(0.75))
+    assert s.get("surfaces.lgp_back.ink_albedo") == 0.75
+    s.set("trace.seed", np.int64(7))
+    assert s.get("trace.seed") == 7 and isinstance(s.get("trace.seed"), int)
+    t = phone.copy()
+    t.set("sources.*.center.2", np.array(0.3))  # a 0-d array is its one value
+    assert t.get("sources.*.center.2") == 0.3
+    s.set("detector.bins", np.array([60, 40], dtype=np.int32))
+    assert s.get("detector.bins") == [60, 40]
+
+
+def test_exceptions_are_named_as_the_package_exports_them(tmp_path):
+    import traceback
+
+    for cls in (bt.BlutraceError, bt.SceneError):
+        assert cls.__module__ == "blutrace" and cls.__qualname__ == cls.__name__
+    with pytest.raises(bt.SceneError) as e:
+        bt.Scene.load(tmp_path / "nothing-here.toml")
+    shown = traceback.format_exception_only(e.type, e.value)[-1]
+    assert shown.startswith("blutrace.SceneError: "), shown
 
 
 def test_a_missing_scene_is_a_scene_error_naming_the_file(tmp_path):
@@ -115,3 +147,30 @@ def test_check_is_what_check_json_prints(cli, box):
     printed = json.loads(run_cli(cli, "check", box.path, "--json").stdout)
     assert mine == printed
     assert mine["scene"] == "bench-box" and mine["tally_bytes"] > 0
+
+
+@pytest.mark.parametrize(
+    "call, says",
+    [
+        (lambda box: bt.Scene.load(5), "path"),
+        (lambda box: bt.Scene.from_toml(5, "scene.toml"), "text"),
+        (lambda box: bt.Scene.from_toml(box.to_toml(), 5), "path"),
+        (lambda box: box.get(5), "key"),
+        (lambda box: box.copy().set(5, 1.0), "key"),
+        (lambda box: box.trace(photons=1000, estimator=None), "estimator"),
+        (lambda box: box.trace(photons=1000, target_metric=1), "target_metric"),
+        (lambda box: box.trace(photons=1000, backend=1), "backend"),
+        (lambda box: box.optimize(method=1), "method"),
+        (lambda box: box.optimize(vary=[("sources.0.center.2", (0.1, 0.3))]), "vary"),
+        (lambda box: box.characterise(5), "tag"),
+        (lambda box: box.trace(photons=1000).write(5), "dir"),
+        (lambda box: bt.merge(5), "runs"),
+        (lambda box: bt.merge([box.trace(photons=1000, shard=(0, 1))], partial="yes"), "partial"),
+        (lambda box: bt.read_exr(5), "path"),
+    ],
+    ids=lambda x: x if isinstance(x, str) else "call",
+)
+def test_an_argument_of_a_wrong_type_is_a_type_error_naming_it(box, call, says):
+    with pytest.raises(TypeError) as e:
+        call(box)
+    assert str(e.value).startswith(f"{says}: "), str(e.value)

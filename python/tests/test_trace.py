@@ -118,6 +118,21 @@ def test_bad_arguments_are_value_errors_naming_them(box, kwargs, says):
         box.trace(**{"photons": 1000, **kwargs})
 
 
+@pytest.mark.parametrize(
+    "kwargs, error, says",
+    [
+        ({"shard": (0,)}, ValueError, "shard"),
+        ({"shard": "0/2"}, ValueError, "shard"),
+        ({"target_error": "small"}, TypeError, "target_error"),
+        ({"max_time": [1.0]}, TypeError, "max_time"),
+    ],
+)
+def test_arguments_of_a_wrong_type_or_shape_are_errors_naming_them(box, kwargs, error, says):
+    with pytest.raises(error) as e:
+        box.trace(**{"photons": 1000, **kwargs})
+    assert says in str(e.value)  # the message itself, not a note pytest's match= also reads
+
+
 def test_photons_may_be_a_whole_float(box):
     assert box.trace(photons=2e4, seed=1).photons == 20_000
 
@@ -186,3 +201,17 @@ def test_a_scene_with_lumens_has_a_luminance_map_and_power_per_source(phone):
     by_source = s["ledger"]["detected_by_source_w"]
     assert len(by_source) == 6
     assert sum(b["w"] for b in by_source) == pytest.approx(s["ledger"]["detected_w"], rel=1e-12)
+
+
+def test_undefined_values_of_a_run_without_light_on_the_target_are_none(box, tmp_path):
+    """NaN in the library (a metric of an empty map) is None here, as null in the JSON."""
+    dark = box.copy()
+    x, y, z = dark.get("detector.origin")
+    dark.set("detector.origin", [x + 1000.0, y, z])  # the detector beside the scene
+    run = dark.trace(photons=20_000, seed=1)
+    assert run.flux.sum() == 0.0
+    s = run.summary
+    assert s["uniformity"]["cv"] is None and s["uniformity"]["min_over_max"] is None
+    json.dumps(s, allow_nan=False)  # no float NaN anywhere
+    run.write(tmp_path)
+    assert json.loads((tmp_path / "summary.json").read_text()) == s

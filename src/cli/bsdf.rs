@@ -39,12 +39,30 @@ pub struct BsdfArgs {
     /// Azimuth step of the table (degrees).
     #[arg(long, default_value_t = 10.0)]
     azimuth_step: f64,
-    /// The direction of sample rotation 0 on the face (default: x, or y on faces facing x).
-    #[arg(long, value_delimiter = ',', num_args = 3)]
+    /// The direction of sample rotation 0 on the face, as `X,Y,Z` or `X Y Z` (default: x,
+    /// or y on faces facing x); a negative X in the first form follows `=`:
+    /// `--u-axis=-1,0,0`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 1..=3,
+        allow_negative_numbers = true,
+        value_name = "X,Y,Z"
+    )]
     u_axis: Option<Vec<f64>>,
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+/// The three components of `--u-axis` (given as `X,Y,Z`, `X Y Z` or a mix).
+fn u_axis(v: &[f64]) -> Result<[f64; 3]> {
+    <[f64; 3]>::try_from(v).map_err(|_| {
+        anyhow::anyhow!(
+            "--u-axis: expected three numbers, X,Y,Z or X Y Z, got {}",
+            v.len()
+        )
+    })
 }
 
 /// Run `blutrace bsdf`.
@@ -57,7 +75,7 @@ pub fn bsdf(args: BsdfArgs) -> Result<()> {
         rotations_deg: args.rotations,
         radial_step_deg: args.radial_step,
         azimuth_step_deg: args.azimuth_step,
-        u_axis: args.u_axis.map(|u| [u[0], u[1], u[2]]),
+        u_axis: args.u_axis.as_deref().map(u_axis).transpose()?,
         seed: args.seed,
     };
     let out = args

@@ -248,9 +248,7 @@ pub fn print_layout_report(r: &LayoutResult) {
 fn print_verified(label: &str, v: &VerifiedDesign, margin: f64) {
     let (u, e) = (&v.summary.uniformity, &v.summary.uniformity_stderr);
     let ev = &v.evaluation;
-    let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
-        .max(0.0)
-        .sqrt();
+    let debiased = blutrace::run::metrics::debiased(ev.area_cv, ev.area_noise_floor);
     say!(
         "{label:<10} area cv {:.4} ± {:.4} (noise floor {:.4}, debiased {debiased:.4}) over the map without {margin} mm at the ends",
         ev.area_cv,

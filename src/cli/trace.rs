@@ -318,9 +318,7 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     );
     let chunk = blutrace::tracer::CHUNK;
     if l.detected_w == 0.0 {
-        say!(
-            "note       no photon reached the target: the map and its uniformity metrics are empty"
-        );
+        eprintln!("warning: {}", run::summary::NO_LIGHT);
     } else if s.photons < 2 * chunk {
         say!(
             "note       errors of the map's metrics (jackknife over chunks of {chunk} photons) need at least {} photons; this run traced {}",
@@ -354,11 +352,19 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
             num(m.cv.value, 3),
             num(m.cv_noise_floor, 3)
         );
-        if m.cv_noise_floor > 0.3 {
-            // The floor falls as 1/sqrt(photons): a floor of 0.1 needs (floor/0.1)^2 times more.
-            let needed = s.photons as f64 * (m.cv_noise_floor / 0.1).powi(2);
+        let needed = match m.photons_needed.is_finite() {
+            true => format!("about {:.1e} photons", m.photons_needed),
+            false => "more photons".to_string(),
+        };
+        if m.photons_in_cone == 0 {
             say!(
-                "note       the luminance map is mostly noise at this photon count (a {}° cone holds few photons): a noise floor of 0.1 needs about {needed:.1e} photons, or widen --luminance-cone-deg",
+                "note       no photon left the target within the {}° cone in {} photons: the luminance map measured nothing (null in summary.json, not 0 cd/m²); a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
+                m.cone_deg,
+                s.photons
+            );
+        } else if m.cv_noise_floor > 0.3 {
+            say!(
+                "note       the luminance map is mostly noise at this photon count (a {}° cone holds few photons): a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
                 m.cone_deg
             );
         }

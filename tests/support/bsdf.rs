@@ -45,6 +45,35 @@ pub fn section(
     }
 }
 
+/// An asymmetric table of `scatter` on sample rotations `rotations` (degrees), uniform
+/// over the hemisphere about the specular direction at AOIs 0 and 60, TIS `tis(rotation)`.
+pub fn rotated(scatter: ScatterType, rotations: &[f64], tis: impl Fn(f64) -> f64) -> String {
+    let (az, rad) = (steps(90.0, 270.0), steps(15.0, 90.0));
+    let one = section(
+        scatter,
+        (&[0.0, 60.0], &az, &rad),
+        false,
+        |_| 0.0,
+        |_, _| 0.2,
+    );
+    let blocks = rotations
+        .iter()
+        .flat_map(|&r| {
+            let t = tis(r);
+            one.blocks.iter().map(move |b| Block {
+                tis: t,
+                ..b.clone()
+            })
+        })
+        .collect();
+    let s = Section {
+        rotations: rotations.to_vec(),
+        blocks,
+        ..one
+    };
+    format::write(&[s], &[])
+}
+
 pub fn steps(step: f64, max: f64) -> Vec<f64> {
     (0..=(max / step).round() as usize)
         .map(|i| i as f64 * step)

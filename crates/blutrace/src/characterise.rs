@@ -23,6 +23,7 @@
 
 use crate::estimator::Estimator;
 use crate::geometry::SurfaceHit;
+use crate::optics::bsdf_table::MAX_U_AXIS_COS;
 use crate::optics::bsdf_table::format::{Block, ScatterType, Section};
 use crate::optics::bsdf_table::sample::{Frame, Grid, Incidence, incidence};
 use crate::optics::medium::MediumId;
@@ -146,14 +147,19 @@ impl<'a> Part<'a> {
         let slab = front
             .interface()
             .and_then(|i| far_face(scene, tag, i.inside, n, origin));
-        let u = opts
-            .u_axis
-            .map(DVec3::from_array)
-            .unwrap_or(if n.x.abs() > 0.9 { DVec3::Y } else { DVec3::X });
-        let u = u - u.dot(n) * n;
-        if u.length() < 1e-6 {
-            bail!("the u axis lies along the face's normal");
+        let u =
+            opts.u_axis
+                .map(unit_axis)
+                .unwrap_or(if n.x.abs() > 0.9 { DVec3::Y } else { DVec3::X });
+        if u.dot(n).abs() > MAX_U_AXIS_COS {
+            bail!(
+                "--u-axis {:?} lies (nearly) along the normal {:?} of tag {:?}: it must lie in the face",
+                u.to_array(),
+                n.to_array(),
+                opts.tag
+            );
         }
+        let u = u - u.dot(n) * n;
         Ok(Part {
             scene,
             front,
@@ -335,7 +341,14 @@ fn nodes(step: f64, max: f64, closed: bool) -> Vec<f64> {
     v
 }
 
-/// Check the options' grids.
+/// The unit vector along `u` (finite and non-zero, as [`check`] makes sure), scaled
+/// first so that no component's square overflows or underflows.
+fn unit_axis(u: [f64; 3]) -> DVec3 {
+    let u = DVec3::from_array(u);
+    (u / u.abs().max_element()).normalize()
+}
+
+/// Check the options' grids and axis.
 fn check(opts: &Options) -> Result<()> {
     if opts.photons == 0 {
         bail!("--photons must be at least 1");
@@ -358,6 +371,11 @@ fn check(opts: &Options) -> Result<()> {
             "--rotations: must increase within [0, 360), got {:?}",
             opts.rotations_deg
         );
+    }
+    if let Some(u) = opts.u_axis
+        && (u.iter().any(|c| !c.is_finite()) || u == [0.0; 3])
+    {
+        bail!("--u-axis: must be a finite, non-zero direction, got {u:?}");
     }
     for (flag, s) in [
         ("--radial-step", opts.radial_step_deg),

@@ -17,7 +17,14 @@
 //! atan(D / 2L) of its axis, 2.0 degrees for a 35 mm aperture at 500 mm, and spot meters'
 //! measuring angles are of that size (Topcon BM-7: 0.1, 0.2, 1 and 2 degrees, BM-7A/BM-7AC
 //! manual; Gamma Scientific GS-1160B: ±1 degree acceptance). A narrow cone sees few
-//! photons: the map's errors say how many more it needs.
+//! photons: the map's errors say how many more it needs, and a map no photon fell in has
+//! no value (`null`), not 0 cd/m².
+//!
+//! The cone is at least [`MIN_CONE_DEG`] wide: a photon is in it when its direction's
+//! cosine with the normal is at least the cone's, `1 - (1 - cos c)`, and that margin
+//! `1 - cos c` ≈ c²/2 must stand far above the cosine's rounding (~1e-16), or the cone is
+//! a rounding artefact (at 1e-300 degrees its solid angle underflows to 0 and the map to
+//! 0/0).
 //!
 //! A photon crossing the rectangle along the normal (from the back, towards the viewer)
 //! is detected and stops there; one crossing the other way passes through.
@@ -105,11 +112,19 @@ impl DetectorSpec {
     }
 }
 
-/// A luminance cone's half-angle (degrees) must lie within (0, 90].
+/// The narrowest luminance cone (half-angle, degrees): there `1 - cos c` is 1.5e-10, so
+/// the cosine's rounding (~1e-16) moves the cone's edge by a millionth of its solid
+/// angle. A hundredth of the narrowest spot meter's angle (0.1 degrees, Topcon BM-7).
+pub const MIN_CONE_DEG: f64 = 0.001;
+
+/// A luminance cone's half-angle (degrees) must lie within [`MIN_CONE_DEG`] ..= 90.
 fn check_cone(deg: f64) -> Result<(), String> {
-    match deg > 0.0 && deg <= 90.0 {
+    match (MIN_CONE_DEG..=90.0).contains(&deg) {
         true => Ok(()),
-        false => Err(format!("must be within (0, 90] degrees, got {deg}")),
+        false => Err(format!(
+            "must be within [{MIN_CONE_DEG}, 90] degrees (a narrower cone is lost in the rounding of the directions' cosines), got {}",
+            crate::spec_check::short(deg)
+        )),
     }
 }
 

@@ -79,15 +79,24 @@ impl SourceSpec {
     }
 
     /// The files the source reads, relative to the scene file (its measured intensity
-    /// table): the content hash covers their bytes, as it does surface models' tables.
+    /// table or ray file, its spectrum file, its body's tables): the content hash covers
+    /// their bytes, as it does surface models' tables.
     pub fn files(&self) -> Vec<PathBuf> {
         let mut files: Vec<PathBuf> = match self {
             SourceSpec::Led(s) => s.intensity_file.iter().cloned().collect(),
             SourceSpec::Ccfl(_) => Vec::new(),
-            SourceSpec::Rayfile(s) => return s.files(),
+            SourceSpec::Rayfile(s) => vec![s.file.clone()],
         };
-        let spectrum = self.common().spectrum.and_then(SpectrumSpec::file);
-        files.extend(spectrum.map(PathBuf::from));
+        let common = self.common();
+        files.extend(
+            common
+                .spectrum
+                .and_then(SpectrumSpec::file)
+                .map(PathBuf::from),
+        );
+        if let BodySpec::Opaque(body) = common.body {
+            files.extend(body.files());
+        }
         files
     }
 

@@ -132,8 +132,9 @@ fn feedback_rounds(
         let before = search.best.as_ref().map(|(_, b, _)| search.score(b));
         let ev = search.evaluate(&density)?;
         let (score, _) = search.score(&ev);
+        // A round without light on the profile (NaN score) gains nothing either.
         match before {
-            Some((b, noise)) if score > b - noise => stalled += 1,
+            Some((b, noise)) if score > b - noise || score.is_nan() => stalled += 1,
             _ => stalled = 0,
         }
         let best = search

@@ -26,8 +26,9 @@
 //!   termination tests. It works on scaled coefficients `z_k = c_k x_max^k` (each is the
 //!   term's density contribution at the far end), so the initial step and the simplex-size
 //!   tolerance are in density units whatever `x_unit` is. A design whose density leaves
-//!   `[min printable, max packing]` anywhere on the face is not traced: it gets the penalty
-//!   `1000 + violation`.
+//!   `[min printable, max packing]` anywhere on the face is not traced: it ranks after
+//!   every feasible design, by its violation ([`nelder_mead::Cost`]), as does a design
+//!   that puts no light on the profile; so weighting the objective changes no step.
 //! - [`feedback`]: per-strip damped ratio updates of a tabulated density (or per cell of a
 //!   density grid with `--dims 2`).
 //! - [`export`]: `dots.csv`, `dots.svg`, `dots.dxf`, placed as the surface's `placement`
@@ -92,6 +93,7 @@ pub fn optimize(
         bail!("option `vary` variables are optimized by optimize_layout");
     }
     let mut search = Search::new(scene, options)?;
+    scene_edit::check_exportable(scene)?;
     let tag = scene.tags[search.tag_id].clone();
     let dots_placement = export_placement(search.pattern.placement, &tag, options)?;
     let initial_density = search.pattern.grade.density.clone();
@@ -113,7 +115,9 @@ pub fn optimize(
     let (Some((first_run, first_ev)), Some((best_run, best_ev, final_density))) =
         (search.first.take(), search.best.take())
     else {
-        bail!("the search traced no design");
+        bail!(
+            "the search found no feasible design: every design it traced put no light on the profile (no uniformity to compare)"
+        );
     };
     let mut pattern = search.pattern.clone();
     pattern.grade.density = final_density.clone();

@@ -13,9 +13,17 @@
 //! its observers must be `'static`, so a borrowed progress callback cannot see the
 //! iterations. The method itself is short; [`minimize`] is tested on Rosenbrock's function
 //! and a quadratic (`tests/optimize.rs`).
+//!
+//! A constrained search ranks its points by [`Cost`]: every feasible point before every
+//! infeasible one, feasible ones by their value, infeasible ones by how far they are from
+//! feasible. The method only ever compares two costs, so scaling the objective by a
+//! positive constant changes no comparison and no point the search visits (a fixed
+//! penalty added to the violation would: an objective scaled past it ranks the
+//! infeasible points first).
 
 use anyhow::Result;
 use serde::Serialize;
+use std::cmp::Ordering;
 
 /// Settings of [`minimize`].
 #[derive(Clone, Debug, PartialEq)]
@@ -109,6 +117,65 @@ impl std::fmt::Display for Termination {
     }
 }
 
+/// What a point of a constrained search costs, in the order [`minimize_ranked`] ranks
+/// points: every `Feasible` before every `Infeasible`.
+#[derive(Clone, Copy, Debug)]
+pub enum Cost {
+    /// A feasible point's objective (NaN and infinities count as infeasible).
+    Feasible(f64),
+    /// A point outside the feasible set, by how far (>= 0; infinite: no distance to
+    /// rank it by).
+    Infeasible(f64),
+}
+
+impl Cost {
+    /// The same cost with a non-finite objective or a NaN distance made
+    /// `Infeasible(inf)`, so that the order is total.
+    fn ranked(self) -> Cost {
+        match self {
+            Cost::Feasible(v) if !v.is_finite() => Cost::Infeasible(f64::INFINITY),
+            Cost::Infeasible(d) if d.is_nan() => Cost::Infeasible(f64::INFINITY),
+            c => c,
+        }
+    }
+
+    /// The objective of a feasible point, `+inf` for an infeasible one.
+    pub fn value(self) -> f64 {
+        match self {
+            Cost::Feasible(v) => v,
+            Cost::Infeasible(_) => f64::INFINITY,
+        }
+    }
+
+    /// Whether the point is feasible.
+    pub fn is_feasible(self) -> bool {
+        matches!(self.ranked(), Cost::Feasible(_))
+    }
+
+    /// The search's order, lexicographic: feasibility first, then the objective or the
+    /// distance.
+    pub fn total_cmp(&self, other: &Cost) -> Ordering {
+        match (self.ranked(), other.ranked()) {
+            (Cost::Feasible(a), Cost::Feasible(b)) => a.total_cmp(&b),
+            (Cost::Infeasible(a), Cost::Infeasible(b)) => a.total_cmp(&b),
+            (Cost::Feasible(_), Cost::Infeasible(_)) => Ordering::Less,
+            (Cost::Infeasible(_), Cost::Feasible(_)) => Ordering::Greater,
+        }
+    }
+}
+
+impl PartialEq for Cost {
+    fn eq(&self, other: &Cost) -> bool {
+        self.total_cmp(other) == Ordering::Equal
+    }
+}
+
+impl PartialOrd for Cost {
+    fn partial_cmp(&self, other: &Cost) -> Option<Ordering> {
+        Some(self.total_cmp(other))
+    }
+}
+
 /// The state after one iteration, for progress reports.
 #[derive(Clone, Debug)]
 pub struct Iteration<'a> {
@@ -120,10 +187,10 @@ pub struct Iteration<'a> {
     pub step: Step,
     /// The best vertex.
     pub best: &'a [f64],
-    /// Its value.
-    pub best_value: f64,
-    /// The worst vertex's value.
-    pub worst_value: f64,
+    /// Its cost.
+    pub best_value: Cost,
+    /// The worst vertex's cost.
+    pub worst_value: Cost,
     /// Largest max-norm distance of a vertex from the best one.
     pub size: f64,
 }
@@ -133,7 +200,7 @@ pub struct Iteration<'a> {
 pub struct Outcome {
     /// The best point found.
     pub x: Vec<f64>,
-    /// Its value.
+    /// Its value ([`Cost::value`]: `+inf` when no point was feasible).
     pub value: f64,
     /// Iterations done.
     pub iterations: usize,
@@ -155,6 +222,24 @@ pub fn minimize(
     settings: &Settings,
     on_iter: &mut dyn FnMut(&Iteration),
 ) -> Result<Outcome> {
+    minimize_ranked(
+        &mut |x| f(x).map(Cost::Feasible),
+        x0,
+        steps,
+        settings,
+        on_iter,
+    )
+}
+
+/// [`minimize`] of a constrained problem: `f` says for each point whether it is feasible
+/// ([`Cost`]); the objective bound and `f_tol` apply to feasible values only.
+pub fn minimize_ranked(
+    f: &mut dyn FnMut(&[f64]) -> Result<Cost>,
+    x0: &[f64],
+    steps: &[f64],
+    settings: &Settings,
+    on_iter: &mut dyn FnMut(&Iteration),
+) -> Result<Outcome> {
     anyhow::ensure!(!x0.is_empty(), "Nelder-Mead needs at least one variable");
     anyhow::ensure!(
         steps.len() == x0.len() && steps.iter().all(|s| s.is_finite() && *s != 0.0),
@@ -162,7 +247,7 @@ pub fn minimize(
     );
     let n = x0.len();
     let mut cost = Counted { f, evaluations: 0 };
-    let mut simplex: Vec<(Vec<f64>, f64)> = Vec::with_capacity(n + 1);
+    let mut simplex: Vec<(Vec<f64>, Cost)> = Vec::with_capacity(n + 1);
     simplex.push((x0.to_vec(), cost.eval(x0)?));
     for (i, s) in steps.iter().enumerate() {
         let mut x = x0.to_vec();
@@ -176,11 +261,15 @@ pub fn minimize(
     loop {
         let (best, worst) = (&simplex[0], &simplex[n]);
         let size = simplex_size(&simplex);
-        let termination = if settings.target.is_some_and(|t| best.1 <= t) {
+        let spread = match (best.1, worst.1) {
+            (Cost::Feasible(b), Cost::Feasible(w)) => (w - b).abs(),
+            _ => f64::INFINITY,
+        };
+        let termination = if settings.target.is_some_and(|t| best.1 <= Cost::Feasible(t)) {
             Some(Termination::ObjectiveBound)
         } else if size <= settings.x_tol {
             Some(Termination::SimplexSize)
-        } else if settings.f_tol > 0.0 && (worst.1 - best.1).abs() <= settings.f_tol {
+        } else if settings.f_tol > 0.0 && spread <= settings.f_tol {
             Some(Termination::ValueSpread)
         } else if iteration >= settings.max_iter {
             Some(Termination::MaxIterations)
@@ -200,7 +289,7 @@ pub fn minimize(
             let (x, value) = simplex.swap_remove(0);
             return Ok(Outcome {
                 x,
-                value,
+                value: value.value(),
                 iterations: iteration,
                 evaluations: cost.evaluations,
                 termination,
@@ -212,27 +301,26 @@ pub fn minimize(
     }
 }
 
-/// The objective with an evaluation counter; NaN ranks as +infinity.
+/// The objective with an evaluation counter; a non-finite objective ranks as infeasible.
 struct Counted<'a> {
-    f: &'a mut dyn FnMut(&[f64]) -> Result<f64>,
+    f: &'a mut dyn FnMut(&[f64]) -> Result<Cost>,
     evaluations: usize,
 }
 
 impl Counted<'_> {
-    fn eval(&mut self, x: &[f64]) -> Result<f64> {
+    fn eval(&mut self, x: &[f64]) -> Result<Cost> {
         self.evaluations += 1;
-        let v = (self.f)(x)?;
-        Ok(if v.is_nan() { f64::INFINITY } else { v })
+        Ok((self.f)(x)?.ranked())
     }
 }
 
-/// Order vertices by value, best first (stable, so ties keep their order).
-fn sort(simplex: &mut [(Vec<f64>, f64)]) {
+/// Order vertices by cost, best first (stable, so ties keep their order).
+fn sort(simplex: &mut [(Vec<f64>, Cost)]) {
     simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
 }
 
 /// Largest max-norm distance of a vertex from the best (first) one.
-fn simplex_size(simplex: &[(Vec<f64>, f64)]) -> f64 {
+fn simplex_size(simplex: &[(Vec<f64>, Cost)]) -> f64 {
     let best = &simplex[0].0;
     simplex[1..]
         .iter()
@@ -246,7 +334,7 @@ fn lerp(a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
 }
 
 /// One Nelder-Mead step on a sorted simplex.
-fn iterate(simplex: &mut [(Vec<f64>, f64)], cost: &mut Counted, s: &Settings) -> Result<Step> {
+fn iterate(simplex: &mut [(Vec<f64>, Cost)], cost: &mut Counted, s: &Settings) -> Result<Step> {
     let n = simplex.len() - 1;
     let mut centroid = vec![0.0; n];
     for (x, _) in &simplex[..n] {

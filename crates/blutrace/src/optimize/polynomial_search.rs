@@ -1,6 +1,6 @@
 //! The Nelder-Mead driver: the simplex over the density polynomial's scaled coefficients.
 
-use super::nelder_mead;
+use super::nelder_mead::{self, Cost};
 use super::report::IterationReport;
 use super::search::{Search, violation};
 use crate::optics::dots::Density;
@@ -81,19 +81,20 @@ fn key(z: &[f64]) -> Vec<u64> {
     z.iter().map(|v| v.to_bits()).collect()
 }
 
-/// The cost of scaled coefficients `z`: the objective, or `1000 + violation` for a
-/// design that leaves the allowed density range (not traced).
-fn cost(s: &mut Search, scaling: &Scaling, z: &[f64]) -> Result<f64> {
+/// The cost of scaled coefficients `z`: the objective, or infeasible by its violation for
+/// a design that leaves the allowed density range (not traced); a traced design without
+/// light on the profile (no objective) is infeasible too.
+fn cost(s: &mut Search, scaling: &Scaling, z: &[f64]) -> Result<Cost> {
     let density = Density::Polynomial(scaling.to_c(z));
     let v = violation(&s.pattern, &density, s.min, s.max);
     if v > 0.0 {
         s.evaluations += 1;
-        return Ok(1000.0 + v.min(1e6));
+        return Ok(Cost::Infeasible(v));
     }
     let ev = s.evaluate(&density)?;
     let objective = ev.objective;
     s.seen.insert(key(z), ev);
-    Ok(objective)
+    Ok(Cost::Feasible(objective))
 }
 
 /// Run Nelder-Mead on `search`; returns why it stopped.
@@ -120,7 +121,7 @@ pub(super) fn run_nelder_mead(
             s.report(it.iteration, it.step.to_string(), c, &ev, progress);
         }
     };
-    let outcome = nelder_mead::minimize(&mut cost, &z0, &steps, &settings, &mut on_iter)?;
+    let outcome = nelder_mead::minimize_ranked(&mut cost, &z0, &steps, &settings, &mut on_iter)?;
     Ok(format!(
         "{} after {} iterations",
         outcome.termination, outcome.iterations

@@ -16,10 +16,10 @@
 
 use super::OptimizeResult;
 use crate::optics::dots::Density;
-use crate::scene::config::{SceneFile, SourceSpec, SurfaceSpec};
+use crate::scene::config::{SceneFile, SurfaceSpec};
 use anyhow::{Context, Result, bail};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 impl OptimizeResult {
     /// The scene file of the final design: the original with the new density, geometry
@@ -70,28 +70,82 @@ fn read_scene_file(path: &Path) -> Result<SceneFile> {
     toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
-/// Make the geometry files and the sources' intensity files absolute (they are relative
-/// to `base`, the folder of the scene file `path`).
+/// The keys whose strings (or arrays of strings) are file paths relative to the scene
+/// file, wherever they stand: geometry, ray, spectrum and BSDF table files (`file`), a
+/// BSDF table's `back_file`, an LED's `intensity_file`.
+const PATH_KEYS: [&str; 3] = ["file", "back_file", "intensity_file"];
+
+/// Make every file path of `file` absolute (they are relative to `base`, the folder of
+/// the scene file `path`), so the file loads from any folder: an optimized scene is
+/// written elsewhere. Errors name the key of a file that cannot be found, and a path
+/// that stays relative (one under a key [`PATH_KEYS`] does not list).
 pub(super) fn make_paths_absolute(file: &mut SceneFile, path: &Path, base: &Path) -> Result<()> {
-    let absolute = |p: &mut PathBuf| -> Result<()> {
-        let joined = base.join(&*p);
-        let found = joined
-            .canonicalize()
-            .with_context(|| format!("{}: cannot find {}", path.display(), joined.display()))?;
-        *p = PathBuf::from(found.to_string_lossy().into_owned());
-        Ok(())
-    };
-    for g in &mut file.geometry {
-        absolute(&mut g.file)?;
-    }
-    for s in &mut file.sources {
-        if let SourceSpec::Led(led) = s
-            && let Some(f) = &mut led.intensity_file
-        {
-            absolute(f)?;
-        }
+    let mut doc = toml::Value::try_from(&*file).context("cannot write the optimized scene")?;
+    absolute_paths(&mut doc, "", path, base)?;
+    *file = doc
+        .try_into()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let declared = (file.geometry.iter().map(|g| g.file.clone()))
+        .chain(file.surfaces.values().flat_map(|s| s.files()))
+        .chain(file.sources.iter().flat_map(|s| s.files()));
+    if let Some(f) = declared.into_iter().find(|f| !f.is_absolute()) {
+        bail!(
+            "{}: cannot write the optimized scene: the path {} stays relative to the scene's folder",
+            path.display(),
+            f.display()
+        );
     }
     Ok(())
+}
+
+/// Make the paths under [`PATH_KEYS`] in `v` (at key path `at`) absolute.
+fn absolute_paths(v: &mut toml::Value, at: &str, path: &Path, base: &Path) -> Result<()> {
+    use toml::Value;
+    let absolute = |p: &mut String, at: &str| -> Result<()> {
+        let joined = base.join(&*p);
+        let found = joined.canonicalize().with_context(|| {
+            format!("{}: {at}: cannot find {}", path.display(), joined.display())
+        })?;
+        *p = found.to_string_lossy().into_owned();
+        Ok(())
+    };
+    match v {
+        Value::Table(t) => {
+            for (k, x) in t.iter_mut() {
+                let at = if at.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{at}.{k}")
+                };
+                match x {
+                    Value::String(p) if PATH_KEYS.contains(&k.as_str()) => absolute(p, &at)?,
+                    Value::Array(a) if PATH_KEYS.contains(&k.as_str()) => {
+                        for (i, x) in a.iter_mut().enumerate() {
+                            if let Value::String(p) = x {
+                                absolute(p, &format!("{at}[{i}]"))?;
+                            }
+                        }
+                    }
+                    x => absolute_paths(x, &at, path, base)?,
+                }
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter_mut().enumerate() {
+                absolute_paths(x, &format!("{at}[{i}]"), path, base)?;
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Check, before a search, that the scene's optimized file can be written: every file it
+/// names is found and made absolute (not found after hours of search).
+pub(super) fn check_exportable(scene: &crate::scene::Scene) -> Result<()> {
+    let mut file = scene.file();
+    let base = scene.path.parent().unwrap_or(Path::new("."));
+    make_paths_absolute(&mut file, &scene.path, base)
 }
 
 /// Replace the density of the dots surface `spec` by `density`.
@@ -128,6 +182,59 @@ mod tests {
             n += 1;
         }
         assert!(n > 0, "no scenes under {}", scenes.display());
+    }
+
+    /// Ray, spectrum and BSDF files, an LED's table and a lamp body's table: every path
+    /// key is made absolute wherever it stands, strings that are not paths are left, and
+    /// a missing file is named by its key.
+    #[test]
+    fn every_path_key_is_made_absolute_wherever_it_stands() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = [
+            "a.obj", "r.rays", "s.csv", "f.bsdf", "b.bsdf", "k.bsdf", "led.ies",
+        ];
+        for f in files {
+            std::fs::write(dir.path().join(f), "").unwrap();
+        }
+        let mut doc: toml::Value = toml::from_str(
+            "name = \"file\"\n[[geometry]]\nfile = \"a.obj\"\n\
+             [surfaces.s]\nfile = [\"f.bsdf\", \"b.bsdf\"]\nback_file = \"k.bsdf\"\n\
+             [[sources]]\nfile = \"r.rays\"\nspectrum = { file = \"s.csv\" }\n\
+             body = { model = \"bsdf_table\", file = \"f.bsdf\" }\n\
+             [[sources]]\nintensity_file = \"led.ies\"\nspectrum = \"cie-led-b5\"\n",
+        )
+        .unwrap();
+        let path = dir.path().join("scene.toml");
+        absolute_paths(&mut doc, "", &path, dir.path()).unwrap();
+        let root = dir.path().canonicalize().unwrap();
+        let abs = |f: &str| root.join(f).to_string_lossy().into_owned();
+        let s = &doc["sources"][0];
+        assert_eq!(doc["geometry"][0]["file"].as_str(), Some(&*abs("a.obj")));
+        assert_eq!(
+            doc["surfaces"]["s"]["file"][1].as_str(),
+            Some(&*abs("b.bsdf"))
+        );
+        assert_eq!(
+            doc["surfaces"]["s"]["back_file"].as_str(),
+            Some(&*abs("k.bsdf"))
+        );
+        assert_eq!(s["file"].as_str(), Some(&*abs("r.rays")));
+        assert_eq!(s["spectrum"]["file"].as_str(), Some(&*abs("s.csv")));
+        assert_eq!(s["body"]["file"].as_str(), Some(&*abs("f.bsdf")));
+        let led = &doc["sources"][1];
+        assert_eq!(led["intensity_file"].as_str(), Some(&*abs("led.ies")));
+        assert_eq!(led["spectrum"].as_str(), Some("cie-led-b5"));
+        assert_eq!(doc["name"].as_str(), Some("file"));
+        let mut gone: toml::Value =
+            toml::from_str("[[sources]]\nspectrum = { file = \"gone.csv\" }\n").unwrap();
+        let e = format!(
+            "{:#}",
+            absolute_paths(&mut gone, "", &path, dir.path()).unwrap_err()
+        );
+        assert!(
+            e.contains("sources[0].spectrum.file") && e.contains("gone.csv"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -8,7 +8,7 @@ use crate::optics::dots::{Density, DotPattern, Gradation};
 use crate::optics::surface::SurfaceModel;
 use crate::run::RunResult;
 use crate::run::metrics::color::{self, Estimate};
-use crate::run::metrics::jackknife_stderr;
+use crate::run::metrics::{debiased, jackknife_stderr};
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
@@ -30,14 +30,13 @@ fn dots_tag(scene: &Scene, tag: Option<&str>) -> Result<usize> {
     };
     match tag {
         Some(t) => {
-            let i = scene
-                .tags
-                .iter()
-                .position(|x| x == t)
-                .with_context(|| format!("{}: no tag '{t}'", scene.path.display()))?;
+            let i =
+                scene.tags.iter().position(|x| x == t).with_context(|| {
+                    format!("{}: option `tag`: no tag '{t}'", scene.path.display())
+                })?;
             if !dots.contains(&i) {
                 bail!(
-                    "{}: surface '{t}' is not model = \"dots\" (dots surfaces: {})",
+                    "{}: option `tag`: surface '{t}' is not model = \"dots\" (dots surfaces: {})",
                     scene.path.display(),
                     names()
                 );
@@ -160,11 +159,11 @@ impl<'a> Search<'a> {
     /// non-uniformity it can fix is across the axis too) debiased by its noise floor
     /// `sqrt(cv^2 - floor^2)` (per-bin noise dominates the raw area cv at few photons),
     /// else the profile cv.
+    /// NaN or infinite for a design that puts no light on the profile: it has no
+    /// uniformity, and is never the best.
     pub(super) fn score(&self, ev: &Evaluation) -> (f64, f64) {
         if self.options.tunes_grid() {
-            let debiased = (ev.area_cv.powi(2) - ev.area_noise_floor.powi(2))
-                .max(0.0)
-                .sqrt();
+            let debiased = debiased(ev.area_cv, ev.area_noise_floor);
             let noise = ev.area_cv_noise * ev.area_cv / debiased.max(ev.area_cv_noise);
             (debiased, noise)
         } else {
@@ -172,7 +171,8 @@ impl<'a> Search<'a> {
         }
     }
 
-    /// Trace a design with the search's seed and photons; keeps the first and the best.
+    /// Trace a design with the search's seed and photons; keeps the first and the best
+    /// feasible one (light on the profile: a finite score).
     pub(super) fn evaluate(&mut self, density: &Density) -> Result<Evaluation> {
         self.evaluations += 1;
         let (run, ev) = self.trace(density, &self.run_options)?;
@@ -180,11 +180,12 @@ impl<'a> Search<'a> {
         if self.first.is_none() {
             self.first = Some((run.clone(), ev.clone()));
         }
+        let score = self.score(&ev).0;
         let better = self
             .best
             .as_ref()
-            .is_none_or(|(_, b, _)| self.score(&ev).0 < self.score(b).0);
-        if better {
+            .is_none_or(|(_, b, _)| score < self.score(b).0);
+        if score.is_finite() && better {
             self.best = Some((run, ev.clone(), density.clone()));
         }
         Ok(ev)

@@ -9,6 +9,10 @@
 //! cv and min/max of a noisy map are biased by the noise itself. Beside cv we report its
 //! noise floor, the cv a perfectly uniform source would show at this photon count
 //! (`sqrt(mean(stderr^2)) / mean`), and the debiased `sqrt(cv^2 - floor^2)`.
+//!
+//! A map that no photon reached has no uniformity: its cv, debiased cv, noise floor and
+//! ratios are NaN (`null` in summary.json), never the 0 of a perfectly uniform map, and
+//! the optimizers rank such a design infeasible.
 
 pub mod color;
 pub mod cone;
@@ -314,13 +318,19 @@ impl Metrics {
             uniformity: u,
             extraction_efficiency: eff,
             cv_noise_floor: floor,
-            cv_debiased: (u.cv * u.cv - floor * floor).max(0.0).sqrt(),
+            cv_debiased: debiased(u.cv, floor),
             mean_rel_stderr: if sums.lit == 0 {
                 f64::NAN
             } else {
                 sums.rel / sums.lit as f64
             },
         }
+    }
+
+    /// Whether any light reached the map: without it there is no uniformity (the cv and
+    /// the ratios are NaN).
+    pub fn has_light(&self) -> bool {
+        self.uniformity.mean > 0.0
     }
 
     /// Every [`Metric`]'s value.
@@ -336,6 +346,18 @@ impl Metrics {
             Metric::ThirteenPoint => u.thirteen_point_min_over_max,
             Metric::MeanRelStderr => self.mean_rel_stderr,
         })
+    }
+}
+
+/// `sqrt(max(x^2 - floor^2, 0))`: a noisy metric `x` with its noise floor removed in
+/// quadrature. NaN when either is NaN (a map without light has neither), not the 0 that
+/// `f64::max` would make of it.
+pub fn debiased(x: f64, floor: f64) -> f64 {
+    let d = x * x - floor * floor;
+    if d.is_nan() {
+        f64::NAN
+    } else {
+        d.max(0.0).sqrt()
     }
 }
 

@@ -82,9 +82,12 @@ pub struct Summary {
     pub polarization: Option<PolarizationSummary>,
     /// Detector geometry.
     pub detector: DetectorSummary,
-    /// Scene-loading warnings.
+    /// Scene-loading warnings, then the run's ([`NO_LIGHT`]).
     pub warnings: Vec<String>,
 }
+
+/// The warning of a run that put no light on the target.
+pub const NO_LIGHT: &str = "no photon reached the target: the flux map has no uniformity (its cv, cv_debiased, noise floor and min/max ratios are null), not a perfectly uniform one";
 
 /// `efficiency = 1 / (rel_error^2 * runtime_s)`: how fast a run buys accuracy. Comparable
 /// between backends and estimators on the same scene and metric.
@@ -313,7 +316,13 @@ impl RunResult {
                 bin_size_mm: d.bin_size(),
                 angular_bins: d.angular_bins,
             },
-            warnings: self.scene.warnings.clone(),
+            warnings: self
+                .scene
+                .warnings
+                .iter()
+                .cloned()
+                .chain((!metrics.has_light()).then(|| NO_LIGHT.to_string()))
+                .collect(),
         }
     }
 }

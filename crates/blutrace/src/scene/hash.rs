@@ -3,10 +3,11 @@
 //! It covers everything that decides the physics, in canonical form: the scene file's
 //! geometry, media, surfaces, sources, detector and bounce cap as serde JSON of the typed
 //! [`SceneFile`] (fixed field order, sorted maps, shortest round-trip floats), the bytes
-//! of the measured tables it names (every file a surface model or a source declares:
-//! [`crate::optics::surface::SurfaceSpecOf::files`], [`SourceSpec::files`]), and the
-//! loaded mesh (vertex coordinates, triangles and tags as little-endian bytes). Not the name, description or the default
-//! photon count and seed.
+//! of the measured tables it names (every file a surface model or a source declares, a
+//! lamp body's model's included: [`crate::optics::surface::SurfaceSpecOf::files`],
+//! [`SourceSpec::files`]), and the loaded mesh (vertex coordinates, triangles and tags
+//! as little-endian bytes). Not the name, description or the default photon count and
+//! seed.
 
 use super::config::{GeometrySpec, MediumSpec, SceneFile, SourceSpec, SurfaceEntry};
 use crate::geometry::Mesh;

@@ -414,14 +414,6 @@ fn checked_len(path: &Path) -> Result<u64> {
 }
 
 impl RayFileSpec {
-    /// The file it reads and the spectrum file, relative to the scene file.
-    pub fn files(&self) -> Vec<PathBuf> {
-        let spectrum = self.spectrum.as_ref().and_then(SpectrumSpec::file);
-        std::iter::once(self.file.clone())
-            .chain(spectrum.map(PathBuf::from))
-            .collect()
-    }
-
     /// Check the entry (`at` names it, `sources[i]`), read its file and build the emitter.
     pub fn emitter(&self, ctx: &Ctx, at: &str) -> Result<RayFileEmitter> {
         let f = |k: &str| format!("{at}.{k}");

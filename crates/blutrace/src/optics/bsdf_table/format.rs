@@ -163,6 +163,11 @@ impl<'a> Words<'a> {
         self.next >= self.words.len()
     }
 
+    /// The words not read yet: no declared count can ask for more numbers than these.
+    fn left(&self) -> usize {
+        self.words.len().saturating_sub(self.next)
+    }
+
     fn word(&mut self, what: &str) -> Result<Word<'a>> {
         match self.words.get(self.next) {
             Some(w) => {
@@ -218,6 +223,15 @@ impl<'a> Words<'a> {
                 ));
             }
         };
+        if n > self.left() {
+            return Err(self.err_at(
+                w.line,
+                format!(
+                    "{key}: declares {n} angles, but only {} numbers follow in the file",
+                    self.left()
+                ),
+            ));
+        }
         let mut out: Vec<f64> = Vec::with_capacity(n);
         for _ in 0..n {
             let (a, line) = self.number(&format!("{key} angle"))?;
@@ -355,7 +369,8 @@ fn section(w: &mut Words) -> Result<Vec<Section>> {
 
 /// The `DataBegin` ... `DataEnd` of `sec`'s grid: its blocks.
 fn data(w: &mut Words, mut sec: Section) -> Result<Section> {
-    w.keyword("DataBegin")?;
+    let line = w.keyword("DataBegin")?;
+    fits(w, line, &sec)?;
     let n = sec.rotations.len() * sec.aoi.len();
     for r in &sec.rotations {
         for a in &sec.aoi {
@@ -376,6 +391,25 @@ fn data(w: &mut Words, mut sec: Section) -> Result<Section> {
         ));
     }
     Ok(sec)
+}
+
+/// Check that the words left in the file hold at least one block of `sec`'s grid (its
+/// `TIS`, the value and the BSDF values) before one is allocated: a count only a damaged
+/// file declares is refused, not allocated (a shorter file ends with its own message).
+fn fits(w: &Words, line: usize, sec: &Section) -> Result<()> {
+    let needed = (sec.azimuth.len() as u128) * (sec.radial.len() as u128) + 2;
+    if needed > w.left() as u128 {
+        return Err(w.err_at(
+            line,
+            format!(
+                "a block of ScatterAzimuth {} x ScatterRadial {} values needs {needed} numbers, but the file holds only {} more: a count is wrong",
+                sec.azimuth.len(),
+                sec.radial.len(),
+                w.left()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn block(w: &mut Words, (rot, aoi): (f64, f64), n_az: usize, n_rad: usize) -> Result<Block> {
@@ -529,6 +563,45 @@ mod tests {
         let twice = xyz(1.0, ["TristimulusX", "TristimulusX", "TristimulusY"]);
         let e = err(&twice);
         assert!(e.contains("line 24:") && e.contains("each once"), "{e}");
+    }
+
+    /// `GOOD` with `n` azimuths and `n` radials (increasing, within range) but its two
+    /// blocks of 2 x 3 values: the counts claim `n * n` values a block.
+    fn huge_grid(n: usize) -> String {
+        let list = |max: f64| {
+            (0..n)
+                .map(|i| format!("{}", max * i as f64 / n as f64))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        GOOD.replace(
+            "ScatterAzimuth  2\n0 180",
+            &format!("ScatterAzimuth  {n}\n{}", list(180.0)),
+        )
+        .replace(
+            "ScatterRadial  3\n0 45 90",
+            &format!("ScatterRadial  {n}\n{}", list(90.0)),
+        )
+    }
+
+    #[test]
+    fn counts_the_file_cannot_hold_are_refused_before_allocating() {
+        // 3000 x 3000 values a block declared in a 50 KB file: an error naming the counts
+        // before the block is allocated (at 100000 x 100000, 80 GB, the allocation
+        // aborted; this size fails safely without the check, at the end of the file).
+        let e = err(&huge_grid(3000));
+        assert!(
+            e.starts_with("t.bsdf: line 16: a block of ScatterAzimuth 3000 x ScatterRadial 3000 values needs 9000002 numbers, but the file holds only 17 more"),
+            "{e}"
+        );
+        // A list longer than the file.
+        let e = err(&GOOD.replace("ScatterRadial  3", "ScatterRadial  99999"));
+        assert!(
+            e.starts_with(
+                "t.bsdf: line 12: ScatterRadial: declares 99999 angles, but only 22 numbers follow"
+            ),
+            "{e}"
+        );
     }
 
     #[test]

@@ -45,8 +45,10 @@
 //! `u_axis`: sample rotations on the back are read from `u_axis` the same way, seen from
 //! the back. Without `back_file` the part is taken as the same seen from both sides, which
 //! a prism film or a film coated on one side is not. The two sides' tables are checked
-//! each on its own (TIS sums at most 1); nothing ties them together (reciprocity between a
-//! front BTDF and a back BTDF is the measurement's business).
+//! each on its own: the TIS sums at most 1 wherever a photon reads them (at every sample
+//! rotation and AOI, the BRDF and the BTDF on different grids too); nothing ties the
+//! sides together (reciprocity between a front BTDF and a back BTDF is the measurement's
+//! business). A block whose values lie (almost) all below the surface is refused.
 //!
 //! What a table leaves out: where the light leaves (a part's lateral spread: light
 //! enters and leaves at one point), polarisation and coherence.
@@ -57,7 +59,7 @@ pub mod sample;
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::{Result, bail};
 use format::{Channel, ScatterType, Section};
 use glam::DVec3;
@@ -66,6 +68,10 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// The largest |cos| between `u_axis` and a face's normal: an axis closer to the normal
+/// (within 2.6 degrees) leaves sample rotation 0 to rounding.
+pub const MAX_U_AXIS_COS: f64 = 0.999;
 
 /// One file or several.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -132,16 +138,28 @@ impl Table {
         let mut blocks = Vec::with_capacity(sec.blocks.len());
         for (k, b) in sec.blocks.iter().enumerate() {
             let s = BlockSampler::new(&grid, aoi[k % aoi.len()], b.tis, &b.values);
-            if s.is_none() && b.tis > 0.0 {
-                bail!(
-                    "{}: line {}: TIS {} of the {} block at AOI {} deg, rotation {} deg, but no value of it lies above the surface",
+            let here = || {
+                format!(
+                    "{}: line {}: TIS {} of the {} block at AOI {} deg, rotation {} deg",
                     file.display(),
                     b.line,
                     b.tis,
                     sec.scatter.keyword(),
                     sec.aoi[k % aoi.len()],
                     sec.rotations[k / aoi.len()]
-                );
+                )
+            };
+            match &s {
+                None if b.tis > 0.0 => {
+                    bail!("{}, but no value of it lies above the surface", here())
+                }
+                Some(s) if b.tis > 0.0 && s.kept < sample::MIN_KEPT => bail!(
+                    "{}, but its values lie (almost) all below the surface: {:.2} % of the directions drawn from them lie above it, less than the {} % a table must give",
+                    here(),
+                    100.0 * s.kept,
+                    100.0 * sample::MIN_KEPT
+                ),
+                _ => {}
             }
             blocks.push(s);
         }
@@ -154,15 +172,30 @@ impl Table {
         })
     }
 
-    /// The nearest sample rotation's index to `rot` (radians, periodic).
+    /// The nearest sample rotation's index to `rot` (radians, periodic; a tie takes the
+    /// lower index): one of the two nodes about it, the rotations being increasing.
     fn rotation(&self, rot: f64) -> usize {
-        let dist = |r: f64| {
-            let d = (r - rot).rem_euclid(TAU);
+        let n = self.rotations.len();
+        let rot = rot.rem_euclid(TAU);
+        let dist = |i: usize| {
+            let d = (self.rotations[i] - rot).rem_euclid(TAU);
             d.min(TAU - d)
         };
+        let k = self.rotations.partition_point(|&r| r < rot);
+        let (a, b) = ((k + n - 1) % n, k % n);
+        match dist(a).total_cmp(&dist(b)) {
+            std::cmp::Ordering::Less => a,
+            std::cmp::Ordering::Greater => b,
+            std::cmp::Ordering::Equal => a.min(b),
+        }
+    }
+
+    /// The largest TIS over the angles of incidence of each sample rotation.
+    fn max_tis(&self) -> Vec<f64> {
+        let n = self.aoi.len();
         (0..self.rotations.len())
-            .min_by(|&a, &b| dist(self.rotations[a]).total_cmp(&dist(self.rotations[b])))
-            .unwrap_or(0)
+            .map(|ri| (0..n).map(|k| self.tis_of(ri * n + k)).fold(0.0, f64::max))
+            .collect()
     }
 
     /// The two blocks about `theta` in rotation `ri` and the weight of the second.
@@ -285,7 +318,7 @@ impl Surface for BsdfTable {
         let Some(u) = self.u_axis else {
             return Ok(());
         };
-        if face.normals().any(|n| n.dot(u).abs() > 0.999) {
+        if face.normals().any(|n| n.dot(u).abs() > MAX_U_AXIS_COS) {
             return Err(ctx.err(
                 &format!("{at}.u_axis"),
                 "is (nearly) along a normal of the face: it must lie in the face",
@@ -439,8 +472,10 @@ fn traced_channel(
     }
 }
 
-/// The reflected and transmitted TIS may not add up to more than 1 at any of either
-/// table's (rotation, AOI) nodes.
+/// The reflected and transmitted TIS may not add up to more than 1 where a photon reads
+/// them: at any sample rotation (each table takes its nearest node, so the pair of nodes
+/// read changes at either table's half-way rotations) and any angle of incidence (each
+/// interpolates linearly between its nodes, so the sum is largest at a node of either).
 fn check_sum(
     ctx: &Ctx,
     field: &str,
@@ -450,25 +485,111 @@ fn check_sum(
     let (Some((pr, r)), Some((pt, t))) = (brdf, btdf) else {
         return Ok(());
     };
-    for tab in [r, t] {
-        for &rot in &tab.rotations {
-            for &aoi in &tab.aoi {
-                let (a, b) = (r.tis(rot, aoi), t.tis(rot, aoi));
-                if a + b > 1.0 + 1e-9 {
-                    return Err(ctx.err(
-                        field,
-                        format!(
-                            "at AOI {} deg, rotation {} deg the BRDF's TIS {a} ({}) and the BTDF's {b} ({}) add up to {}, more than 1",
-                            aoi.to_degrees(),
-                            rot.to_degrees(),
-                            pr.display(),
-                            pt.display(),
-                            a + b
-                        ),
-                    ));
-                }
+    let (max_r, max_t) = (r.max_tis(), t.max_tis());
+    let mut aois: Vec<f64> = r.aoi.iter().chain(&t.aoi).copied().collect();
+    aois.sort_by(f64::total_cmp);
+    aois.dedup();
+    for rot in rotation_probes(r, t) {
+        let (ri, ti) = (r.rotation(rot), t.rotation(rot));
+        if max_r[ri] + max_t[ti] <= 1.0 + TIS_SUM_TOLERANCE {
+            continue;
+        }
+        for &aoi in &aois {
+            let (a, b) = (r.tis(rot, aoi), t.tis(rot, aoi));
+            if a + b > 1.0 + TIS_SUM_TOLERANCE {
+                return Err(ctx.err(
+                    field,
+                    format!(
+                        "at AOI {} deg, sample rotation {} deg the BRDF's TIS {a} ({}, its rotation {} deg) and the BTDF's {b} ({}, its rotation {} deg) add up to {}, more than 1",
+                        short(aoi.to_degrees()),
+                        short(rot.to_degrees()),
+                        pr.display(),
+                        short(r.rotations[ri].to_degrees()),
+                        pt.display(),
+                        short(t.rotations[ti].to_degrees()),
+                        short(a + b)
+                    ),
+                ));
             }
         }
     }
     Ok(())
+}
+
+/// How far above 1 the reflected and transmitted TIS may add up (rounding in the files).
+const TIS_SUM_TOLERANCE: f64 = 1e-9;
+
+/// Sample rotations (radians) that meet every pair of nodes two tables read together:
+/// both tables' nodes and the rotations where either's nearest node changes (half-way
+/// between its nodes), and the middle of each interval between these (the pair is the
+/// same across an interval).
+fn rotation_probes(a: &Table, b: &Table) -> Vec<f64> {
+    let mut edges: Vec<f64> = a
+        .rotations
+        .iter()
+        .chain(&b.rotations)
+        .copied()
+        .chain(half_way_round(&a.rotations))
+        .chain(half_way_round(&b.rotations))
+        .collect();
+    edges.sort_by(f64::total_cmp);
+    edges.dedup();
+    let middles: Vec<f64> = half_way_round(&edges).collect();
+    edges.extend(middles);
+    edges.sort_by(f64::total_cmp);
+    edges
+}
+
+/// The angles half-way between neighbours of the increasing angles `v` (radians, in
+/// [0, 2 pi)), round the circle: the last one's is half-way to the first plus 2 pi.
+fn half_way_round(v: &[f64]) -> impl Iterator<Item = f64> + '_ {
+    let n = v.len();
+    (0..n).map(move |i| {
+        let next = if i + 1 < n { v[i + 1] } else { v[0] + TAU };
+        (0.5 * (v[i] + next)).rem_euclid(TAU)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A table of no scatter on `rotations` (degrees), for its rotation lookup.
+    fn on_rotations(rotations: &[f64]) -> Table {
+        Table {
+            kind: ScatterType::Brdf,
+            rotations: rotations.iter().map(|r| r.to_radians()).collect(),
+            aoi: vec![0.0],
+            grid: Grid::new(&[0.0], &[0.0], false),
+            blocks: vec![None; rotations.len()],
+        }
+    }
+
+    #[test]
+    fn the_nearest_rotation_is_the_nearest_of_all_round_the_circle() {
+        for rotations in [
+            &[0.0][..],
+            &[10.0, 100.0, 350.0],
+            &[0.0, 90.0, 180.0, 270.0],
+            &[5.0, 6.0, 7.0, 200.0],
+        ] {
+            let t = on_rotations(rotations);
+            let dist = |i: usize, rot: f64| {
+                let d = (t.rotations[i] - rot).rem_euclid(TAU);
+                d.min(TAU - d)
+            };
+            for step in 0..7200 {
+                let rot = (step as f64 * 0.05).to_radians();
+                let all = (0..rotations.len())
+                    .min_by(|&a, &b| dist(a, rot).total_cmp(&dist(b, rot)))
+                    .unwrap();
+                assert_eq!(t.rotation(rot), all, "{rotations:?} at {rot}");
+                let wrapped = t.rotation(rot - TAU);
+                assert!(
+                    dist(wrapped, rot) <= dist(all, rot) + 1e-12,
+                    "{rotations:?} at {rot} - 2 pi"
+                );
+            }
+        }
+    }
 }

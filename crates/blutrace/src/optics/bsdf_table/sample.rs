@@ -42,6 +42,11 @@ use std::f64::consts::{PI, TAU};
 /// checks: each cell it can draw has directions above the surface).
 pub const MAX_TRIES: usize = 10_000;
 
+/// The least share of a block's draws that may land above the surface
+/// ([`BlockSampler::kept`]): a block whose values lie (almost) all below the surface
+/// would take hundreds of draws a photon, and is refused when the table is read instead.
+pub const MIN_KEPT: f64 = 0.01;
+
 /// How a photon meets a face: the angles that pick the table's block and the frame its
 /// scattered directions are measured in.
 #[derive(Clone, Copy, Debug)]
@@ -282,6 +287,9 @@ pub struct BlockSampler {
     cdf: Vec<f64>,
     /// Each cell's `c_max`.
     c_max: Vec<f64>,
+    /// The expected share of draws kept (landing above the surface): [`Self::sample`]
+    /// takes `1 / kept` draws on average.
+    pub kept: f64,
 }
 
 impl BlockSampler {
@@ -290,17 +298,28 @@ impl BlockSampler {
     pub fn new(grid: &Grid, theta: f64, tis: f64, values: &[Vec<f64>]) -> Option<BlockSampler> {
         let n_r = grid.n_radial();
         let (mut cdf, mut c_max) = (Vec::new(), Vec::new());
-        let mut total = 0.0;
+        let (mut total, mut above) = (0.0, 0.0);
+        // The block's own frame (the sampler draws in it): only its AOI matters here.
+        let d = DVec3::new(theta.sin(), 0.0, -theta.cos());
+        let frame = Frame::new(ScatterType::Brdf, &incidence(d, DVec3::Z, DVec3::X));
         for (ia, row) in values.iter().enumerate() {
             for (ir, f) in row.iter().enumerate().take(n_r) {
                 let r = (grid.radial_edges[ir], grid.radial_edges[ir + 1]);
                 let c = max_cos(theta, r, (grid.az_lo[ia], grid.az_width[ia]));
                 total += f * grid.solid_angle(ia, ir) * c;
+                if *f > 0.0 && c > 0.0 {
+                    above += f * grid.projected_solid_angle(&frame, ia, ir, 4);
+                }
                 cdf.push(total);
                 c_max.push(c);
             }
         }
-        (total > 0.0).then_some(BlockSampler { tis, cdf, c_max })
+        (total > 0.0).then_some(BlockSampler {
+            tis,
+            cdf,
+            c_max,
+            kept: above / total,
+        })
     }
 
     /// A direction drawn from the block's `f cos+` density in `frame` (`None`: gave up

@@ -13,11 +13,14 @@
 //! - The search: integer variables (a row's `count`) are enumerated, and for each of their
 //!   combinations the continuous ones are searched by Nelder-Mead (the dots optimizer's,
 //!   in coordinates scaled to each variable's range, `--initial-step` and `--simplex-tol`
-//!   being fractions of the range; a point outside the bounds is not traced and gets the
-//!   penalty `1000 + distance`) or scanned on a grid of `--grid-points` per variable (one
-//!   or two variables). Every design is traced with the same seed and photons (common
-//!   random numbers); a design whose scene does not load (a lamp row wider than its box)
-//!   gets the penalty, and its reason is reported.
+//!   being fractions of the range) or scanned on a grid of `--grid-points` per variable
+//!   (one or two variables). Every design is traced with the same seed and photons
+//!   (common random numbers). Infeasible designs rank after every feasible one
+//!   ([`crate::optimize::nelder_mead::Cost`]), whatever the objective's weights: a point
+//!   outside the bounds (not traced; by its distance, so the simplex is pulled back in), a
+//!   design whose scene does not load (a lamp row wider than its box; its reason is
+//!   reported), and one that puts no light on the target (its uniformity undefined).
+//!   None of them is ever the best design.
 //! - After the search the scene's own design and the best one are re-traced with a fresh
 //!   seed and `--verify-photons`.
 
@@ -33,12 +36,13 @@ pub use search::EvaluationRecord;
 pub use vary::{Variable, VarySpec};
 pub use write::OUTPUT_NAMES;
 
+use super::nelder_mead::Cost;
 use super::nelder_mead::{self, Settings};
 use super::{Method, OptimizeOptions};
 use crate::run::is_interrupted;
 use crate::scene::Scene;
 use anyhow::{Result, bail};
-use search::{LayoutSearch, PENALTY};
+use search::LayoutSearch;
 use std::collections::HashMap;
 use std::time::Instant;
 use toml::Value;
@@ -58,6 +62,7 @@ pub fn optimize_layout(
     let vars = resolve_variables(&doc, options)?;
     check_method(options, &vars)?;
     options.objective.check(scene, true, options.method)?;
+    crate::optimize::scene_edit::check_exportable(scene)?;
     if options.photons == 0 {
         bail!("option `photons` must be at least 1");
     }
@@ -71,6 +76,7 @@ pub fn optimize_layout(
         start: Instant::now(),
         photons: 0,
         history: Vec::new(),
+        first: None,
         best: None,
         seen: Default::default(),
         builds: Default::default(),
@@ -79,7 +85,7 @@ pub fn optimize_layout(
     };
     let initial_x: Vec<f64> = search.vars.iter().map(|v| v.initial).collect();
     search.evaluate(&initial_x, progress)?;
-    let Some((initial_run, initial, _)) = search.best.clone() else {
+    let Some((initial_run, initial)) = search.first.clone() else {
         bail!("the scene's own design was not traced");
     };
     if search.vars.iter().any(|v| !v.contains(v.initial)) {
@@ -94,7 +100,9 @@ pub fn optimize_layout(
         }
     }
     let Some((_, best, best_x)) = search.best.clone() else {
-        bail!("the search traced no design");
+        bail!(
+            "the search found no feasible design: every design it traced put no light on the target (no uniformity to compare) or did not load"
+        );
     };
     result::finish(search, (initial_run, initial), best, best_x, cases)
 }
@@ -218,12 +226,12 @@ fn search_case(
         })
         .collect();
     let evaluations = search.history.len();
-    let mut case_best: Option<(f64, f64, Vec<f64>)> = None;
+    let mut case_best: Option<(Cost, f64, Vec<f64>)> = None;
     // Every point asked for, by its scaled coordinates' bits: the simplex may ask for a
     // point again (a rejected one, or a shrink back onto a vertex); with common random
     // numbers its objective is the same, so it is neither traced nor reported twice.
-    let mut asked: HashMap<Vec<u64>, f64> = HashMap::new();
-    let mut eval = |search: &mut LayoutSearch, z: &[f64]| -> Result<f64> {
+    let mut asked: HashMap<Vec<u64>, Cost> = HashMap::new();
+    let mut eval = |search: &mut LayoutSearch, z: &[f64]| -> Result<Cost> {
         // Bounds are inclusive as written: a point past an end by rounding (a few ulps of
         // the scaled coordinate) is that end.
         let z: Vec<f64> = z
@@ -244,12 +252,13 @@ fn search_case(
         let outside = z.iter().map(|z| (-z).max(z - 1.0)).fold(0.0, f64::max);
         if outside > 0.0 {
             search.reject_out_of_bounds(&x, progress);
-            asked.insert(key, PENALTY + outside);
-            return Ok(PENALTY + outside);
+            asked.insert(key, Cost::Infeasible(outside));
+            return Ok(Cost::Infeasible(outside));
         }
         let (value, noise) = search.evaluate(&x, progress)?;
         asked.insert(key, value);
-        if case_best.as_ref().is_none_or(|(b, _, _)| value < *b) {
+        let better = case_best.as_ref().is_none_or(|(b, _, _)| value < *b);
+        if value.is_feasible() && better {
             case_best = Some((value, noise, x));
         }
         Ok(value)
@@ -265,8 +274,10 @@ fn search_case(
         }
         Err(e) => return Err(e),
     };
-    let (objective, noise, values) =
-        case_best.unwrap_or((f64::NAN, f64::NAN, full(search, &scaled)));
+    let (objective, noise, values) = match case_best {
+        Some((cost, noise, x)) => (cost.value(), noise, x),
+        None => (f64::NAN, f64::NAN, full(search, &scaled)),
+    };
 
     Ok(IntegerCase {
         integers: ints.iter().flatten().copied().collect(),
@@ -284,7 +295,7 @@ fn scan_case(
     search: &mut LayoutSearch,
     free: &[usize],
     scaled: &[f64],
-    eval: &mut dyn FnMut(&mut LayoutSearch, &[f64]) -> Result<f64>,
+    eval: &mut dyn FnMut(&mut LayoutSearch, &[f64]) -> Result<Cost>,
 ) -> Result<String> {
     let termination = match (free.is_empty(), search.options.method) {
         (true, _) => {
@@ -305,18 +316,18 @@ fn scan_case(
             // coarse grid instead (one or two variables).
             let mut start = scaled.to_vec();
             let mut how = String::new();
-            if eval(search, &start)? >= PENALTY && free.len() <= 2 {
-                let mut best: Option<(f64, Vec<f64>)> = None;
+            if !eval(search, &start)?.is_feasible() && free.len() <= 2 {
+                let mut best: Option<(Cost, Vec<f64>)> = None;
                 for z in grid(free.len(), o.grid_points) {
                     let v = eval(search, &z)?;
-                    if v < PENALTY && best.as_ref().is_none_or(|(b, _)| v < *b) {
+                    if v.is_feasible() && best.as_ref().is_none_or(|(b, _)| v < *b) {
                         best = Some((v, z));
                     }
                 }
                 if let Some((_, z)) = best {
                     start = z;
-                    how =
-                        "; started from the best of a grid, the scene's design not loading".into();
+                    how = "; started from the best of a grid, the scene's design being infeasible"
+                        .into();
                 }
             }
             let scaled = start;
@@ -335,7 +346,7 @@ fn scan_case(
                 x_tol: o.simplex_tol,
                 ..Settings::default()
             };
-            let out = nelder_mead::minimize(
+            let out = nelder_mead::minimize_ranked(
                 &mut |z| eval(search, z),
                 &scaled,
                 &steps,

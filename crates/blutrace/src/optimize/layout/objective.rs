@@ -51,7 +51,13 @@ pub fn evaluate(spec: &ObjectiveSpec, run: &RunResult) -> Result<LayoutEvaluatio
             .collect();
         jackknife_stderr(&lo)
     };
-    let objective = |m: &MetricValues, d: f64| spec.value(&term_values(m, d));
+    // Without light on the target no term means anything (an efficiency of 0 included):
+    // the design is infeasible, its objective NaN.
+    let lit = metrics.has_light();
+    let objective = |m: &MetricValues, d: f64| match lit {
+        true => spec.value(&term_values(m, d)),
+        false => f64::NAN,
+    };
     let l = &run.tally.ledger;
     Ok(LayoutEvaluation {
         objective: objective(&values, duv.unwrap_or(f64::NAN)),
@@ -73,7 +79,8 @@ pub fn evaluate(spec: &ObjectiveSpec, run: &RunResult) -> Result<LayoutEvaluatio
 /// One traced design, judged.
 #[derive(Clone, Debug, Serialize)]
 pub struct LayoutEvaluation {
-    /// The objective (to minimize).
+    /// The objective (to minimize); NaN when no light reached the target (the design is
+    /// infeasible).
     pub objective: f64,
     /// Its standard error (jackknife).
     pub noise: f64,
@@ -125,6 +132,9 @@ impl std::fmt::Display for LayoutEvaluation {
         f.write_str(")")?;
         if self.below_noise_floor() {
             f.write_str("  [cv below its noise floor: trace more photons]")?;
+        }
+        if self.efficiency == 0.0 {
+            f.write_str("  [no light on the target: infeasible]")?;
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use super::vary::Variable;
 use crate::optimize::ObjectiveSpec;
 use crate::optimize::OptimizeOptions;
 use crate::optimize::design::Design;
+use crate::optimize::nelder_mead::Cost;
 use crate::run::RunResult;
 use crate::run::{MeshBuildCache, RunOptions};
 use crate::scene::Scene;
@@ -17,11 +18,6 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::time::Instant;
 use toml::Value;
-
-/// Objective of a design the search does not trace (outside the bounds, or a scene that
-/// does not load): worse than any traced design, and growing with the distance outside
-/// the bounds so the simplex is pulled back in.
-pub(super) const PENALTY: f64 = 1000.0;
 
 /// One evaluated design: a row of `history.csv` and a progress line.
 #[derive(Clone, Debug, Serialize)]
@@ -63,11 +59,15 @@ pub(super) struct LayoutSearch<'a> {
     pub(super) start: Instant,
     pub(super) photons: u64,
     pub(super) history: Vec<EvaluationRecord>,
-    /// The best traced design: its run, evaluation and variables.
+    /// The first traced design (the scene's own): its run and evaluation.
+    pub(super) first: Option<(RunResult, LayoutEvaluation)>,
+    /// The best feasible design (light on the target, an objective): its run,
+    /// evaluation and variables.
     pub(super) best: Option<(RunResult, LayoutEvaluation, Vec<f64>)>,
-    /// Objective of every design evaluated, by the bits of its variables: a design met
-    /// again (the scene's own at the start of each case) is not traced twice.
-    pub(super) seen: HashMap<Vec<u64>, (f64, f64)>,
+    /// Cost and objective noise of every design evaluated, by the bits of its variables:
+    /// a design met again (the scene's own at the start of each case) is not traced
+    /// twice.
+    pub(super) seen: HashMap<Vec<u64>, (Cost, f64)>,
     /// The last design's backend and triangle records, reused by the next design when
     /// its mesh is the same (a search that moves only the lamps).
     pub(super) builds: RefCell<MeshBuildCache>,
@@ -92,13 +92,15 @@ impl<'a> LayoutSearch<'a> {
         doc
     }
 
-    /// Evaluate the design `x` (inside the bounds): its objective and standard error, or
-    /// the penalty when the scene does not load. Keeps the best; `progress` sees the record.
+    /// Evaluate the design `x` (inside the bounds): its cost (the objective; infeasible
+    /// when the scene does not load, or when no light reaches the target and the
+    /// objective is undefined) and the objective's standard error. Keeps the first and
+    /// the best feasible design; `progress` sees the record.
     pub(super) fn evaluate(
         &mut self,
         x: &[f64],
         progress: &mut dyn FnMut(&EvaluationRecord, &[String]),
-    ) -> Result<(f64, f64)> {
+    ) -> Result<(Cost, f64)> {
         let key: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
         if let Some(&seen) = self.seen.get(&key) {
             return Ok(seen);
@@ -107,17 +109,22 @@ impl<'a> LayoutSearch<'a> {
             Ok(scene) => {
                 let (run, ev) = self.trace_scene(scene, &self.run_options.clone())?;
                 self.photons += ev.photons;
-                let value = ev.objective;
-                if self
+                let value = Cost::Feasible(ev.objective);
+                if self.first.is_none() {
+                    self.first = Some((run.clone(), ev.clone()));
+                }
+                let better = self
                     .best
                     .as_ref()
-                    .is_none_or(|(_, b, _)| value < b.objective)
-                {
+                    .is_none_or(|(_, b, _)| value < Cost::Feasible(b.objective));
+                if value.is_feasible() && better {
                     self.best = Some((run, ev.clone(), x.to_vec()));
                 }
                 (Some(ev), None, value)
             }
-            Err(e) => (None, Some(format!("{e:#}")), PENALTY),
+            // No distance to feasible: ranked before the points outside the bounds, as
+            // the bounds' distance is what pulls the simplex back in.
+            Err(e) => (None, Some(format!("{e:#}")), Cost::Infeasible(0.0)),
         };
         let noise = result.as_ref().map_or(f64::NAN, |r| r.noise);
         self.seen.insert(key, (value, noise));

@@ -234,10 +234,7 @@ fn debiased(own: &[f64], leave_out: &[Vec<f64>]) -> (f64, Vec<f64>, f64) {
     } else {
         noise_floor(&lit)
     };
-    let debias = |v: &[f64]| {
-        let d = largest_offset(v, &used);
-        (d * d - floor * floor).max(0.0).sqrt()
-    };
+    let debias = |v: &[f64]| super::debiased(largest_offset(v, &used), floor);
     let lo = leave_out.iter().map(|v| debias(v)).collect();
     (debias(own), lo, floor)
 }

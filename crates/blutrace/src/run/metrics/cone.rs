@@ -60,17 +60,24 @@ pub fn luminance_cone_map(scene: &Scene, t: &Tally) -> Option<Map> {
     Some(map_of(scene, g, t.ledger.photons, efficacy))
 }
 
-/// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity.
+/// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity. When no
+/// photon fell within the cone (`photons_in_cone` 0) the map measured nothing: every
+/// estimate is NaN (`null`), not 0 ± 0 cd/m².
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LuminanceMapSummary {
     /// Half-angle of the cone (degrees).
     pub cone_deg: f64,
+    /// Photons that left the target within the cone (over every bin).
+    pub photons_in_cone: u64,
     /// Mean luminance over the target (cd/m²).
     pub mean_cd_m2: Estimate,
     /// RMS deviation over mean of the map.
     pub cv: Estimate,
     /// The cv a perfectly uniform panel would show from noise alone.
     pub cv_noise_floor: f64,
+    /// About how many photons a noise floor of 0.1 needs ([`photons_needed`]; NaN: no
+    /// estimate).
+    pub photons_needed: f64,
     /// `sqrt(max(cv^2 - floor^2, 0))`.
     pub cv_debiased: Estimate,
     /// Smallest bin over largest.
@@ -107,18 +114,51 @@ pub fn luminance_map_summary(
         })
         .collect();
     let values = own.values();
-    let est = |m: Metric| Estimate {
-        value: values[m],
-        stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
+    let photons_in_cone: u64 = grid.bins.iter().map(|b| b.hits).sum();
+    let est = |m: Metric| match photons_in_cone {
+        0 => Estimate {
+            value: f64::NAN,
+            stderr: f64::NAN,
+        },
+        _ => Estimate {
+            value: values[m],
+            stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
+        },
     };
     Some(LuminanceMapSummary {
         cone_deg: scene.detector.luminance_cone_deg,
+        photons_in_cone,
         mean_cd_m2: est(Metric::Mean),
         cv: est(Metric::Cv),
         cv_noise_floor: own.cv_noise_floor,
+        photons_needed: photons_needed(scene, total, photons_in_cone, own.cv_noise_floor),
         cv_debiased: est(Metric::CvDebiased),
         min_over_max: est(Metric::MinOverMax),
         nine_point_min_over_max: est(Metric::NinePoint),
         thirteen_point_min_over_max: est(Metric::ThirteenPoint),
     })
+}
+
+/// About how many photons the luminance map needs for a noise floor of 0.1 (NaN: no
+/// estimate). The floor falls as 1/sqrt(photons), so a map with photons in its cone
+/// (`in_cone`) and floor `floor` needs `(floor / 0.1)^2` times as many. An empty map is
+/// estimated from the angular grid's first theta row: the cone holds its photons in the
+/// ratio of their projected solid angles, `sin^2(cone) / sin^2(row)` (exact for light of
+/// uniform radiance near the normal), and a floor of 0.1 takes about 100 photons a bin
+/// (Poisson: 1/sqrt(100)).
+pub fn photons_needed(scene: &Scene, t: &Tally, in_cone: u64, floor: f64) -> f64 {
+    let n = t.ledger.photons as f64;
+    if in_cone > 0 {
+        return n * (floor / 0.1).powi(2);
+    }
+    let d = &scene.detector;
+    let [nt, np] = d.angular_bins;
+    let row: u64 = (0..np).map(|ip| t.angular.bins[ip * nt].hits).sum();
+    let sin2 = |deg: f64| deg.to_radians().sin().powi(2);
+    let per_photon = row as f64 / n * sin2(d.luminance_cone_deg) / sin2(90.0 / nt as f64);
+    let bins = (d.bins[0] * d.bins[1]) as f64;
+    match per_photon > 0.0 {
+        true => 100.0 * bins / per_photon,
+        false => f64::NAN,
+    }
 }

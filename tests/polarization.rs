@@ -260,14 +260,25 @@ fn total_internal_reflection_turns_linear_light_elliptic() {
                 [detector]\norigin = [-5.0, -50.0, 0.0]\nu = [0.0, 0.0, 1.0]\nv = [0.0, 1.0, 0.0]\n\
                 size_mm = [10.0, 100.0]\nbins = [2, 2]\n";
     let rays = "3 0 -5  0 0 1  1.0\n";
-    let r = run("tir", toml, &[("prism.obj", obj), ("beam.rays", rays)], 20_000);
-    let p = r.summary().polarization.expect("a polarized source traces polarization");
+    let r = run(
+        "tir",
+        toml,
+        &[("prism.obj", obj), ("beam.rays", rays)],
+        20_000,
+    );
+    let p = r
+        .summary()
+        .polarization
+        .expect("a polarized source traces polarization");
     let n: f64 = 1.0 / 1.49;
     let (s, c) = 45f64.to_radians().sin_cos();
     let want = (2.0 * (c * (s * s - n * n).sqrt() / (s * s)).atan()).sin();
     assert!((want - 0.573).abs() < 1e-3);
     // A few photons come back after three reflections (two partial ones): 2e-3 allowed.
-    assert!((p.s3.value.abs() - want).abs() < 2e-3, "{p:?}, want |S3| {want}");
+    assert!(
+        (p.s3.value.abs() - want).abs() < 2e-3,
+        "{p:?}, want |S3| {want}"
+    );
     assert!((p.dop.value - 1.0).abs() < 2e-3, "{p:?}");
 }
 
@@ -294,4 +305,70 @@ fn brewsters_angle_reflects_no_p_light() {
     // The ray file's u is x, in the plane of incidence: 0 degrees is p, 90 is s.
     assert_eq!(reflected(0.0), 0.0);
     assert!(reflected(90.0) > 0.2, "s light reflects from both faces");
+}
+
+/// The Stokes sums are exact: shards (through their JSON files' round trip) merge to the
+/// single run's bit for bit, whatever the threads; polarization is part of the content
+/// hash, so shards traced with and without it do not merge.
+#[test]
+fn polarized_shards_merge_to_the_single_run_bit_for_bit() {
+    use blutrace::run::{RunOptions, Shard};
+    use blutrace::shard::{self, ShardFile};
+    let obj = sheet("floor", 0.0, 50.0, 0) + &sheet("film", 1.0, 50.0, 4);
+    let toml = format!(
+        "version = 1\n[[geometry]]\nfile = \"cavity.obj\"\n\
+         [surfaces.floor]\nmodel = \"lambert\"\nalbedo = 0.8\n{}\
+         [[sources]]\ntype = \"led\"\ncenter = [0.0, 0.0, 0.01]\nnormal = [0.0, 0.0, 1.0]\n\
+         u = [1.0, 0.0, 0.0]\nwidth_mm = 0.5\nheight_mm = 0.5\npower_w = 1.0\n\
+         [detector]\norigin = [-50.0, -50.0, 2.0]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\n\
+         size_mm = [100.0, 100.0]\nbins = [4, 4]\n",
+        polarizer("film", 20.0, 0.9)
+    );
+    let dir = write_scene("pol-shards", &toml, &[("cavity.obj", obj.as_str())]);
+    let scene = load(&dir);
+    let options = RunOptions {
+        photons: 60_000,
+        seed: 5,
+        threads: Some(2),
+        ..RunOptions::default()
+    };
+    let single = support::trace_opts(&scene, &options);
+    let one_thread = support::trace_opts(
+        &scene,
+        &RunOptions {
+            threads: Some(1),
+            ..options.clone()
+        },
+    );
+    assert_eq!(single.tally, one_thread.tally);
+    let shards: Vec<_> = (0..3)
+        .map(|index| {
+            let shard = Some(Shard { index, count: 3 });
+            let run = support::trace_opts(
+                &scene,
+                &RunOptions {
+                    shard,
+                    ..options.clone()
+                },
+            );
+            let text = serde_json::to_string(&ShardFile::of(&run).unwrap()).unwrap();
+            let file: ShardFile = serde_json::from_str(&text).unwrap();
+            (format!("shard {index}/3").into(), file)
+        })
+        .collect();
+    let merged = shard::merge(&shards, &scene).unwrap();
+    assert_eq!(merged.tally.stokes, single.tally.stokes);
+    assert!(
+        single.tally.stokes.unwrap()[0].0 != 0,
+        "the light is polarized"
+    );
+    let averaged = std::fs::read_to_string(&*dir).unwrap() + "[trace]\npolarization = false\n";
+    let averaged = averaged.replace(
+        &polarizer("film", 20.0, 0.9),
+        "[surfaces.film]\nmodel = \"lambert\"\nalbedo = 0.5\n",
+    );
+    let other = write_scene("pol-shards-off", &averaged, &[("cavity.obj", obj.as_str())]);
+    let with = averaged.replace("polarization = false", "polarization = true");
+    let on = write_scene("pol-shards-on", &with, &[("cavity.obj", obj.as_str())]);
+    assert_ne!(load(&other).content_hash(), load(&on).content_hash());
 }

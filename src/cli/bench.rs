@@ -147,7 +147,10 @@ fn polarization_table(
     for r in rows {
         say!(
             "| {} | {:.0} | {:.0} | {:.3} |",
-            r.scene, r.averaged_per_s, r.polarized_per_s, r.ratio
+            r.scene,
+            r.averaged_per_s,
+            r.polarized_per_s,
+            r.ratio
         );
     }
     Ok(())

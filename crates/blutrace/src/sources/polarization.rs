@@ -50,7 +50,10 @@ impl TryFrom<Keys> for SourcePolarizationSpec {
         match (k.linear_deg, k.stokes) {
             (Some(linear_deg), None) => Ok(SourcePolarizationSpec::Linear { linear_deg }),
             (None, Some(stokes)) => Ok(SourcePolarizationSpec::Stokes { stokes }),
-            _ => Err("polarization: give one of { linear_deg = D } or { stokes = [S0, S1, S2, S3] }".into()),
+            _ => Err(
+                "polarization: give one of { linear_deg = D } or { stokes = [S0, S1, S2, S3] }"
+                    .into(),
+            ),
         }
     }
 }

@@ -554,6 +554,7 @@ mod tests {
             power_w: p,
             lumens: None,
             spectrum: None,
+            polarization: None,
             emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal: DVec3::Z,

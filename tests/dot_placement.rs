@@ -569,6 +569,8 @@ fn walk(scene: &Scene, pitch: f64, random_phase: bool, photons: u64) -> (f64, f6
                 medium: pmma,
                 est: Estimator::Analog,
                 light: Light::MONOCHROME,
+                pol: None,
+                pol_out: &std::cell::Cell::new(None),
             };
             let (out, feature) = model.interact_on(&at, &mut rng);
             if z == 0.0 {

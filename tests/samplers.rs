@@ -351,6 +351,7 @@ fn measured_led_directions_follow_the_intensity_profile() {
             power_w: 1.0,
             lumens: None,
             spectrum: None,
+            polarization: None,
             emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal,

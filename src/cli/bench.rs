@@ -129,6 +129,30 @@ pub(super) fn bench(
             r.fom_bins
         );
     }
+    say!();
+    reader_still_there()?;
+    polarization_table(&[box_scene, scene], photons, threads, repeat)
+}
+
+/// The cost of polarized transport on `dirs` (see `blutrace_bench::polarization`).
+fn polarization_table(
+    dirs: &[&Path],
+    photons: u64,
+    threads: Option<usize>,
+    repeat: usize,
+) -> Result<()> {
+    let rows = blutrace_bench::polarization_table(dirs, photons, threads, repeat)?;
+    say!("| {photons} photons | averaged Fresnel photons/s | polarized photons/s | ratio |");
+    say!("|---|---:|---:|---:|");
+    for r in rows {
+        say!(
+            "| {} | {:.0} | {:.0} | {:.3} |",
+            r.scene,
+            r.averaged_per_s,
+            r.polarized_per_s,
+            r.ratio
+        );
+    }
     Ok(())
 }
 

@@ -23,17 +23,20 @@
 //! the light guide alone: the convex path against each backend; a third, queries in the
 //! lamp cavities against the 540k-triangle mesh alone ([`cavity`], at most 3 rounds): the
 //! backends without the shared per-hit code, and Embree's ray packets on emission and
-//! second-bounce rays. A last table gives the error reached in a fixed tracing time per backend and
-//! estimator, with the figure of merit `1 / (error^2 * seconds)`.
+//! second-bounce rays. A next table gives the error reached in a fixed tracing time per backend and
+//! estimator, with the figure of merit `1 / (error^2 * seconds)`; a last, the cost of
+//! polarized transport on both scenes ([`polarization`]).
 
 pub mod box_scene;
 pub mod cavity;
 pub mod load;
+pub mod polarization;
 pub mod reference;
 pub mod reference_before;
 
 pub use cavity::large_mesh_table;
 pub use load::large_load_row;
+pub use polarization::polarization_table;
 
 use anyhow::{Context, Result};
 use blutrace::accel::{self, Accel, BackendChoice};

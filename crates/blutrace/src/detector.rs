@@ -30,6 +30,7 @@
 //! is detected and stops there; one crossing the other way passes through.
 
 use crate::geometry::Ray;
+use crate::optics::polarization::Polarization;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -288,6 +289,17 @@ impl TargetPlane {
         let t0 = FRAC_PI_2 * it as f64 / nt as f64;
         let t1 = FRAC_PI_2 * (it + 1) as f64 / nt as f64;
         0.5 * (t1.sin().powi(2) - t0.sin().powi(2)) * TAU / np as f64
+    }
+
+    /// The state `pol` of light detected along unit `dir`, as `(S1, S2, S3) / S0` in the
+    /// detector's frame: `u` made perpendicular to `dir` (`S1 > 0` along it), `v = dir x u`
+    /// (at grazing `dir` along `u`, `v` made perpendicular instead).
+    pub fn stokes_of(&self, pol: &Polarization, dir: DVec3) -> [f64; 3] {
+        let frame = (self.u - self.u.dot(dir) * dir)
+            .try_normalize()
+            .unwrap_or_else(|| dir.cross(self.v).normalize());
+        let [_, s1, s2, s3] = pol.stokes_in(dir, frame).0;
+        [s1, s2, s3]
     }
 }
 

@@ -23,6 +23,7 @@ pub mod body_shape;
 pub mod ccfl;
 pub mod intensity;
 pub mod led;
+pub mod polarization;
 pub mod rayfile;
 pub mod spectrum;
 
@@ -61,6 +62,7 @@ struct Common<'a> {
     power_w: Option<f64>,
     lumens: Option<f64>,
     spectrum: Option<&'a SpectrumSpec>,
+    polarization: Option<&'a polarization::SourcePolarizationSpec>,
     medium: &'a str,
     body: &'a BodySpec,
     package_depth_mm: Option<f64>,
@@ -119,6 +121,7 @@ impl SourceSpec {
                 power_w: Some(s.power_w),
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: None,
@@ -128,6 +131,7 @@ impl SourceSpec {
                 power_w: Some(s.power_w),
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: s.package_depth_mm,
@@ -137,6 +141,7 @@ impl SourceSpec {
                 power_w: s.power_w,
                 lumens: s.lumens,
                 spectrum: s.spectrum.as_ref(),
+                polarization: s.polarization.as_ref(),
                 medium: &s.medium,
                 body: &s.body,
                 package_depth_mm: s.package_depth_mm,
@@ -196,6 +201,10 @@ impl SourceSpec {
             },
             lumens: ctx.optional_positive(&f("lumens"), common.lumens)?,
             spectrum: spectrum.map(Arc::new),
+            polarization: common
+                .polarization
+                .map(|p| p.build(ctx, &f("polarization")))
+                .transpose()?,
             emitter,
             medium: medium_id(ctx, &f("medium"), common.medium, media)?,
             body,
@@ -253,6 +262,16 @@ impl Emitter {
                 Some(r.set.total_flux())
             }
             _ => None,
+        }
+    }
+
+    /// The axis a source's `polarization` is given against: an LED's `u`, a tube's axis,
+    /// a ray file's placed x axis.
+    pub fn u_axis(&self) -> DVec3 {
+        match self {
+            Emitter::Ccfl(t) => t.axis,
+            Emitter::Led(l) => l.u,
+            Emitter::RayFile(r) => r.front.u,
         }
     }
 
@@ -340,6 +359,9 @@ pub struct Source {
     pub lumens: Option<f64>,
     /// Its emission spectrum (`None`: monochrome light).
     pub spectrum: Option<Arc<EmissionSpectrum>>,
+    /// The state its light starts in, in the frame of [`Emitter::u_axis`] (`None`:
+    /// unpolarized).
+    pub polarization: Option<crate::optics::polarization::Stokes>,
     /// Shape and angular profile.
     pub emitter: Emitter,
     /// Medium the source emits into.
@@ -532,6 +554,7 @@ mod tests {
             power_w: p,
             lumens: None,
             spectrum: None,
+            polarization: None,
             emitter: Emitter::Led(FlatLed {
                 center: DVec3::ZERO,
                 normal: DVec3::Z,

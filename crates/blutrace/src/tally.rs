@@ -488,6 +488,10 @@ pub struct Tally {
     /// as the Y tally; else radiant weight), when the sources give lumens or spectra.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cone: Option<Grid>,
+    /// Sums over the detected light of its weight times `S1/S0`, `S2/S0`, `S3/S0` in the
+    /// detector's frame, when polarization is traced.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stokes: Option<[ExactSum; 3]>,
 }
 
 impl Tally {
@@ -503,6 +507,7 @@ impl Tally {
                 .then(|| ColorTally::new(&flux, &angular)),
             cone: (scene.sources.spectral() || scene.sources.luminous_efficacy().is_some())
                 .then(|| Grid::new(flux.nx, flux.ny)),
+            stokes: scene.polarized.then(Default::default),
             flux,
             angular,
             ledger: Ledger::new(
@@ -539,6 +544,7 @@ impl Tally {
             .into_iter()
             .chain(t.color.iter().flat_map(ColorTally::shape))
             .chain(t.cone.iter().map(|g| (g.nx, g.ny, g.bins.len())))
+            .chain(t.stokes.iter().map(|s| (s.len(), 0, 0)))
             .collect::<Vec<_>>()
         };
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
@@ -577,6 +583,13 @@ impl Tally {
                 l.checked_accounted()
                     .map_or("more than a tally holds".into(), |a| a.value().to_string())
             )
+        } else if self
+            .stokes
+            .iter()
+            .flatten()
+            .any(|s| s.0.abs() > l.detected.sum.0)
+        {
+            "a Stokes sum exceeds the detected power".into()
         } else if negative || l.detected.hits > photons || l.killed_photons > photons {
             "a sink holds negative weight, or more photons than were emitted".into()
         } else if by_source_total != Some(l.detected) {
@@ -608,6 +621,11 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
             a.checked_merge(b)?;
         }
+        if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.checked_add(*y)?;
+            }
+        }
         self.ledger.checked_merge(&o.ledger)
     }
 
@@ -620,6 +638,11 @@ impl Tally {
         }
         if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
             a.merge_signed(b, sign);
+        }
+        if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
+            a.iter_mut()
+                .zip(b)
+                .for_each(|(x, y)| x.merge_signed(*y, sign));
         }
         self.ledger.merge_signed(&o.ledger, sign);
     }
@@ -656,6 +679,15 @@ impl Tally {
                 cone.bins[d.flux_bin as usize].merge(one);
             }
         }
+        if let Some(stokes) = &mut self.stokes {
+            for d in &c.detections {
+                let s = d.stokes.unwrap_or_default();
+                stokes
+                    .iter_mut()
+                    .zip(s)
+                    .for_each(|(sum, k)| sum.add(d.weight * k));
+            }
+        }
         self.ledger.merge(&c.ledger);
     }
 }
@@ -673,6 +705,8 @@ pub struct Detection {
     pub light: Light,
     /// Whether it left within the detector's luminance cone.
     pub in_cone: bool,
+    /// Its `(S1, S2, S3) / S0` in the detector's frame, when polarization is traced.
+    pub stokes: Option<[f64; 3]>,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between

@@ -27,6 +27,7 @@ use crate::accel::convex::ConvexSolid;
 use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::absorber::Absorber;
 use crate::optics::model::Arrival;
+use crate::optics::polarization::Polarization;
 use crate::optics::spectrum::Light;
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::optics::two_sided;
@@ -37,6 +38,7 @@ use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
 use body_boxes::BodyBoxes;
 use flight::Flight;
 use solid_walk::Walks;
+use std::cell::Cell;
 
 /// The convex solid of `medium` when the convex path is on and the medium has one.
 fn convex_solid(scene: &Scene, convex: bool, medium: MediumId) -> Option<&ConvexSolid> {
@@ -79,6 +81,8 @@ struct Photon {
     weight: f64,
     /// Its light, drawn with its emission: what it meets is read at it.
     light: Light,
+    /// Its polarization, when the scene traces it.
+    pol: Option<Polarization>,
     /// Analog estimator: the optical depth of clear-medium absorption the photon has
     /// left (an Exp(1) draw, made on its first absorbing segment; negative until then).
     absorption_depth: f64,
@@ -111,7 +115,8 @@ impl<'a> Tracer<'a> {
             estimator,
             convex,
             facets,
-            walks: Walks::new(scene, convex, &bodies),
+            // The walks' Fresnel events average s and p: not for polarized light.
+            walks: Walks::new(scene, convex && !scene.polarized, &bodies),
             bodies,
         }
     }
@@ -125,6 +130,10 @@ impl<'a> Tracer<'a> {
             medium: e.medium,
             weight: 1.0,
             light: e.light,
+            pol: self
+                .scene
+                .polarized
+                .then(|| emitted_polarization(self.scene, &e)),
             absorption_depth: -1.0,
         };
         out.ledger.photons += 1;
@@ -164,14 +173,18 @@ impl<'a> Tracer<'a> {
             }
             if let Some((_, ab)) = detected {
                 let weight = p.light.detected(p.weight);
-                out.detections
-                    .push(detection(scene, ab, true_ray.dir, weight, p.light));
+                let mut hit = detection(scene, ab, true_ray.dir, weight, p.light);
+                hit.stokes = p
+                    .pol
+                    .map(|pol| scene.detector.stokes_of(&pol, true_ray.dir));
+                out.detections.push(hit);
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
                 return Fate::Escaped;
             };
             let model = self.model(struck, true_ray.dir, surf.normal);
+            let pol_out = Cell::new(None);
             let at = Arrival {
                 media: &scene.media,
                 hit: &surf,
@@ -179,6 +192,8 @@ impl<'a> Tracer<'a> {
                 medium: p.medium,
                 est: self.estimator,
                 light: p.light,
+                pol: p.pol,
+                pol_out: &pol_out,
             };
             let (outcome, feature) = model.interact_on(&at, rng);
             struck.count(&mut out.ledger, feature);
@@ -192,6 +207,10 @@ impl<'a> Tracer<'a> {
                     p.reweigh(weight, struck.sink(&mut out.ledger));
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
+                    if p.pol.is_some() {
+                        // A model that keeps no state leaves the light unpolarized.
+                        p.pol = Some(pol_out.get().unwrap_or(Polarization::unpolarized(dir)));
+                    }
                 }
             }
             if !roulette(p, rng, &mut out.ledger) {
@@ -319,6 +338,8 @@ impl<'a> Tracer<'a> {
             if let Flight::Scattered { t, dir } = flight {
                 // Inside the medium, clear of surfaces: the search needs no nudge.
                 p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
+                // Volume scattering depolarizes (a stand-in: Mie scattering polarizes).
+                p.pol = p.pol.map(|_| Polarization::unpolarized(dir));
             }
             return flight;
         }
@@ -444,6 +465,21 @@ fn absorb_clear(
     }
 }
 
+/// The state a photon leaves its source `e.source` in: the source's, in the frame of its
+/// u axis made perpendicular to the photon's direction, or unpolarized.
+fn emitted_polarization(scene: &Scene, e: &crate::sources::Emission) -> Polarization {
+    let d = e.ray.dir;
+    let source = &scene.sources.list[e.source];
+    let frame = source.emitter.u_axis();
+    match (
+        source.polarization,
+        (frame - frame.dot(d) * d).try_normalize(),
+    ) {
+        (Some(stokes), Some(u)) => Polarization { stokes, u },
+        _ => Polarization::unpolarized(d),
+    }
+}
+
 /// Russian roulette on low weights (weighted estimator only): false when the photon dies.
 fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
     if p.weight >= ROULETTE_BELOW {
@@ -472,6 +508,7 @@ fn detection(
         weight,
         light,
         in_cone: d.in_cone(dir),
+        stokes: None,
     }
 }
 

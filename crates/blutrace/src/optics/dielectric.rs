@@ -8,9 +8,9 @@
 //! outside = "air"              # default "air" (n = 1)
 //! ```
 
-use super::fresnel;
 use super::medium::{Interface, Medium, MediumId, air};
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -70,7 +70,10 @@ pub fn scatter(at: &Arrival, iface: &Interface, rng: &mut PhotonRng) -> (DVec3, 
     } else {
         (iface.inside, iface.outside, -normal, n_inside, n_outside)
     };
-    match fresnel::roulette(dir, facing, n1, n2, rng) {
+    let mut pol = at.pol;
+    let refracted = polarization::fresnel_roulette(dir, facing, (n1, n2), pol.as_mut(), rng);
+    at.pol_out.set(pol);
+    match refracted {
         Some(t) => (t, to),
         None => (fresnel::reflect(dir, facing), from),
     }

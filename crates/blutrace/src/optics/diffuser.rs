@@ -32,6 +32,7 @@
 use super::fresnel;
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::polarization::{Polarization, fresnel_roulette};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -70,7 +71,10 @@ impl Surface for Diffuser {
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let i = &self.interface;
-        let out = scatter(self.roughness, at.indices(i), at.hit.normal, at.dir, rng);
+        let mut pol = at.pol;
+        let (normal, indices) = (at.hit.normal, at.indices(i));
+        let out = scatter_carrying(self.roughness, indices, normal, at.dir, pol.as_mut(), rng);
+        at.pol_out.set(pol);
         (at.lossless(i, out), Feature::Plain)
     }
 
@@ -135,9 +139,22 @@ pub fn sample_visible_normal(n: DVec3, wi: DVec3, alpha: f64, u1: f64, u2: f64) 
 /// direction and whether it leaves into the inside medium.
 pub fn scatter(
     alpha: f64,
+    indices: (f64, f64),
+    normal: DVec3,
+    dir: DVec3,
+    rng: &mut PhotonRng,
+) -> (DVec3, bool) {
+    scatter_carrying(alpha, indices, normal, dir, None, rng)
+}
+
+/// [`scatter`], carrying `pol` (when polarization is traced) through every facet's
+/// Fresnel event.
+pub fn scatter_carrying(
+    alpha: f64,
     (n_inside, n_outside): (f64, f64),
     normal: DVec3,
     dir: DVec3,
+    mut pol: Option<&mut Polarization>,
     rng: &mut PhotonRng,
 ) -> (DVec3, bool) {
     let mut inside = dir.dot(normal) > 0.0;
@@ -156,7 +173,7 @@ pub fn scatter(
         if -d.dot(m) <= 0.0 {
             continue; // a facet seen edge-on (rounding): draw another
         }
-        match fresnel::roulette(d, m, n1, n2, rng) {
+        match fresnel_roulette(d, m, (n1, n2), pol.as_deref_mut(), rng) {
             Some(t) => {
                 d = t;
                 inside = !inside;
@@ -166,6 +183,9 @@ pub fn scatter(
     }
     let facing = if inside { -normal } else { normal };
     if d.dot(facing) < 0.0 {
+        if let Some(p) = pol {
+            *p = super::polarization::mirrored(p, d, facing);
+        }
         d = fresnel::reflect(d, facing);
     }
     (d, inside)

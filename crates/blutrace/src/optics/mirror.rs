@@ -6,10 +6,10 @@
 //! reflectance = 0.97   # default 1
 //! ```
 
-use super::fresnel;
 use super::medium::Medium;
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::spectrum::{Range, Spectral, SpectralValue};
+use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -52,6 +52,10 @@ impl Surface for Mirror {
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let facing = at.facing();
         let out = at.reflect(&self.reflectance, rng, |_| Some(direction(at.dir, facing)));
+        // A perfect conductor's Mueller matrix, scaled to the reflectance (a stand-in:
+        // a metal's retardance is left out).
+        let mirrored = at.pol.map(|p| polarization::mirrored(&p, at.dir, facing));
+        at.pol_out.set(mirrored);
         (out, Feature::Plain)
     }
 }

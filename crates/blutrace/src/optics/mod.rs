@@ -31,6 +31,7 @@ pub mod phase;
 pub mod phong;
 pub mod placement;
 pub mod polarization;
+pub mod polarizer;
 pub mod sampling;
 pub mod spectrum;
 pub mod surface;

@@ -4,6 +4,7 @@
 //! and are registered in [`super::surface`].
 
 use super::medium::{Interface, Medium, MediumId};
+use super::polarization::Polarization;
 use super::spectrum::{Light, Spectral};
 use crate::estimator::Estimator;
 use crate::geometry::{Mesh, SurfaceHit};
@@ -11,6 +12,7 @@ use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
+use std::cell::Cell;
 use std::path::PathBuf;
 
 /// A model's scene-file table: it checks itself and builds the model.
@@ -90,6 +92,12 @@ pub struct Arrival<'a> {
     pub est: Estimator,
     /// Its light: the optical quantities it meets are read at it ([`super::spectrum`]).
     pub light: Light,
+    /// Its polarization, when the run traces it ([`super::polarization`]).
+    pub pol: Option<Polarization>,
+    /// Where a model that keeps polarization (interfaces, mirrors, polarizers) puts the
+    /// state of the light that leaves; left `None`, the light leaves unpolarized (every
+    /// diffuse model).
+    pub pol_out: &'a Cell<Option<Polarization>>,
 }
 
 impl Arrival<'_> {

@@ -218,6 +218,84 @@ pub fn block_direction(d: DVec3, block: DVec3) -> Option<DVec3> {
     (block - block.dot(d) * d).try_normalize()
 }
 
+/// A photon's polarization: its Stokes vector, of unit power, referred to the unit
+/// vector `u` perpendicular to its direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Polarization {
+    /// The state, `S0 = 1`.
+    pub stokes: Stokes,
+    /// The frame's `u` (perpendicular to the direction of travel).
+    pub u: DVec3,
+}
+
+impl Polarization {
+    /// Unpolarized light travelling along unit `d`.
+    pub fn unpolarized(d: DVec3) -> Polarization {
+        Polarization {
+            stokes: Stokes::UNPOLARIZED,
+            u: any_frame(d),
+        }
+    }
+
+    /// The state of light along unit `d` referred to the unit `to` (perpendicular to `d`).
+    pub fn stokes_in(&self, d: DVec3, to: DVec3) -> Stokes {
+        self.stokes.reframed(d, self.u, to)
+    }
+
+    /// The state after `m` (in the frame `u`), scaled back to unit power.
+    fn after(m: &Mueller, s: Stokes, u: DVec3) -> Polarization {
+        Polarization {
+            stokes: m.apply(s).normalized(),
+            u,
+        }
+    }
+}
+
+/// [`super::fresnel::roulette`] for polarized light: reflected with probability
+/// `R(S)`, the power the reflection Mueller matrix passes of the photon's state (always
+/// under total internal reflection), else refracted; `pol` becomes the state of the
+/// light that leaves, in the frame `u = s`. `None` for `pol` is the averaged roulette,
+/// with the same random numbers.
+#[inline]
+pub fn fresnel_roulette(
+    dir: DVec3,
+    facing: DVec3,
+    (n1, n2): (f64, f64),
+    pol: Option<&mut Polarization>,
+    rng: &mut crate::rng::PhotonRng,
+) -> Option<DVec3> {
+    let Some(pol) = pol else {
+        return super::fresnel::roulette(dir, facing, n1, n2, rng);
+    };
+    let s = s_axis(dir, facing, pol.u);
+    let stokes = pol.stokes_in(dir, s);
+    let cos_i = -dir.dot(facing);
+    let reflection = fresnel_reflection(cos_i, n1, n2);
+    let r = reflection.power_of(stokes);
+    let transmission = fresnel_transmission(cos_i, n1, n2);
+    let refracted = match transmission {
+        Some(t) if r < 1.0 && rng.uniform() >= r => Some(t),
+        _ => None,
+    };
+    match refracted {
+        Some(t) => {
+            *pol = Polarization::after(&t, stokes, s);
+            super::fresnel::refract(dir, facing, n1, n2)
+        }
+        None => {
+            *pol = Polarization::after(&reflection, stokes, s);
+            None
+        }
+    }
+}
+
+/// The state of light after a mirror of reflectance `r` (any `r`: the state is scaled
+/// back to unit power), reflected from unit `dir` at the unit normal `facing`.
+pub fn mirrored(pol: &Polarization, dir: DVec3, facing: DVec3) -> Polarization {
+    let s = s_axis(dir, facing, pol.u);
+    Polarization::after(&mirror(1.0), pol.stokes_in(dir, s), s)
+}
+
 #[cfg(test)]
 #[path = "polarization_tests.rs"]
 mod tests;

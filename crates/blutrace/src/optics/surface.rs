@@ -138,6 +138,8 @@ surface_models! {
     "mirror" => Mirror(Mirror, MirrorSpec),
     /// Black absorber ([`super::absorber`]).
     "absorber" => Absorber(Absorber, AbsorberSpec),
+    /// Absorbing or reflective polarizer sheet ([`super::polarizer`]).
+    "polarizer" => Polarizer(super::polarizer::Polarizer, super::polarizer::PolarizerSpec),
     /// Measured BSDF table, IS BSDF format ([`super::bsdf_table`]).
     "bsdf_table" => BsdfTable(super::bsdf_table::BsdfTable, super::bsdf_table::BsdfTableSpec),
 }
@@ -156,6 +158,7 @@ impl SurfaceModel {
         rng: &mut PhotonRng,
     ) -> Outcome {
         let light = Light::MONOCHROME;
+        let pol_out = std::cell::Cell::new(None);
         let at = Arrival {
             media,
             hit,
@@ -163,6 +166,8 @@ impl SurfaceModel {
             medium,
             est,
             light,
+            pol: None,
+            pol_out: &pol_out,
         };
         self.interact_on(&at, rng).0
     }

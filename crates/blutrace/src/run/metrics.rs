@@ -17,6 +17,7 @@
 pub mod color;
 pub mod cone;
 mod jackknife;
+pub mod stokes;
 
 pub use jackknife::{
     BinSet, Estimates, ScoredBins, estimates, jackknife, jackknife_stderr, leave_one_out,

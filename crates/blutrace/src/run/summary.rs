@@ -2,6 +2,7 @@
 
 use super::metrics::color::{ColorSummary, color_summary};
 use super::metrics::cone::{LuminanceMapSummary, luminance_map_summary};
+use super::metrics::stokes::{PolarizationSummary, polarization_summary};
 use super::metrics::{Metric, MetricValues, Metrics, Uniformity};
 use super::{ConvergenceRow, RunResult, StoppedBy, TargetMetric, relative_error};
 use crate::optics::surface::Estimator;
@@ -76,6 +77,9 @@ pub struct Summary {
     /// ([`super::metrics::color`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub color: Option<ColorSummary>,
+    /// The target light's polarization, when it is traced ([`super::metrics::stokes`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polarization: Option<PolarizationSummary>,
     /// Detector geometry.
     pub detector: DetectorSummary,
     /// Scene-loading warnings, then the run's ([`NO_LIGHT`]).
@@ -302,6 +306,7 @@ impl RunResult {
             }),
             luminance_map: luminance_map_summary(&self.scene, &self.tally, &self.groups),
             color: color_summary(&self.scene, &self.tally, &self.groups),
+            polarization: polarization_summary(&self.tally, &self.groups),
             detector: DetectorSummary {
                 origin_mm: (d.origin + self.scene.offset).to_array(),
                 u: d.u.to_array(),

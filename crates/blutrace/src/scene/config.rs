@@ -97,6 +97,10 @@ pub struct TraceSpec {
     /// Surface events before a photon is killed.
     #[serde(default = "default_max_bounces")]
     pub max_bounces: u32,
+    /// Trace polarization (Stokes vectors, exact Fresnel): `true`, `false`, or unset for
+    /// on exactly when the scene has a polarizer ([`crate::optics::polarization`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarization: Option<bool>,
 }
 
 impl Default for TraceSpec {
@@ -105,6 +109,7 @@ impl Default for TraceSpec {
             photons: default_photons(),
             seed: default_seed(),
             max_bounces: default_max_bounces(),
+            polarization: None,
         }
     }
 }

@@ -25,10 +25,13 @@ struct Physics<'a> {
     sources: &'a [SourceSpec],
     detector: &'a super::config::DetectorSpec,
     max_bounces: u32,
+    /// Whether polarization is traced (the file's key resolved).
+    polarized: bool,
 }
 
-/// Hash of the scene file `file` (read from `path`) and the intensity tables it names.
-pub(super) fn file_hash(file: &SceneFile, path: &Path) -> Result<u64> {
+/// Hash of the scene file `file` (read from `path`) and the intensity tables it names;
+/// `polarized`: whether the scene traces polarization.
+pub(super) fn file_hash(file: &SceneFile, path: &Path, polarized: bool) -> Result<u64> {
     let physics = Physics {
         geometry: &file.geometry,
         media: &file.media,
@@ -36,6 +39,7 @@ pub(super) fn file_hash(file: &SceneFile, path: &Path) -> Result<u64> {
         sources: &file.sources,
         detector: &file.detector,
         max_bounces: file.trace.max_bounces,
+        polarized,
     };
     let mut h = Fnv1a::default();
     h.write(&serde_json::to_vec(&physics)?);

@@ -76,6 +76,8 @@ pub struct Scene {
     pub convex: Vec<Option<ConvexSolid>>,
     /// Every file loading read ([`inputs`]): outputs never replace one of them.
     pub inputs: Vec<PathBuf>,
+    /// Whether photons carry their polarization ([`crate::optics::polarization`]).
+    pub polarized: bool,
     /// Hash of the scene file's physics sections and the tables they name.
     file_hash: u64,
     /// The scene file as written ([`Scene::source`]; [`key_path`] reads and edits it).
@@ -174,6 +176,7 @@ impl Scene {
             &media,
             &sources.list,
         )?;
+        let polarized = traces_polarization(&ctx, file, (&surfaces, &backs), &sources)?;
         let detector = file.detector.build(&ctx)?;
         if file.trace.photons == 0 {
             return Err(ctx.err("trace.photons", "must be at least 1"));
@@ -204,7 +207,8 @@ impl Scene {
             geometry,
             convex: Vec::new(),
             inputs: inputs::input_files(file, path),
-            file_hash: hash::file_hash(file, path)?,
+            file_hash: hash::file_hash(file, path, polarized)?,
+            polarized,
             source,
         };
         scene.recenter();
@@ -550,4 +554,27 @@ fn fit_models_to_faces(
         s.fit_to_face(ctx, &format!("surfaces.{}", tags[tag_id]), &face)?;
     }
     Ok(())
+}
+
+/// Whether the scene traces polarization: `[trace] polarization`, else whether a surface
+/// is a polarizer (which needs it: `false` with one is an error) or a source polarized.
+fn traces_polarization(
+    ctx: &Ctx,
+    file: &SceneFile,
+    (surfaces, backs): (&[SurfaceModel], &[Option<SurfaceModel>]),
+    sources: &Sources,
+) -> Result<bool> {
+    let all = surfaces.iter().chain(backs.iter().flatten());
+    let polarizer = all
+        .into_iter()
+        .any(|m| matches!(m, SurfaceModel::Polarizer(_)));
+    let polarized_source = sources.list.iter().any(|s| s.polarization.is_some());
+    match file.trace.polarization {
+        Some(false) if polarizer => Err(ctx.err(
+            "trace.polarization",
+            "is false, but a surface is a polarizer, which needs polarization traced",
+        )),
+        Some(on) => Ok(on),
+        None => Ok(polarizer || polarized_source),
+    }
 }

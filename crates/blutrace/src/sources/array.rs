@@ -92,6 +92,7 @@ mod tests {
             power_w: 2.0,
             lumens: None,
             spectrum: None,
+            polarization: None,
             emitter: Emitter::Ccfl(Tube {
                 center: DVec3::new(10.0, 0.0, 5.0),
                 axis: DVec3::Y,

@@ -43,6 +43,9 @@ pub struct CcflSpec {
     pub power_w: f64,
     /// Luminous flux (lm), for luminance outputs.
     pub lumens: Option<f64>,
+    /// The state of the emitted light ([`super::polarization`]); unpolarized without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarization: Option<super::polarization::SourcePolarizationSpec>,
     /// Emission spectrum ([`super::spectrum`]); without it the source is monochrome.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectrum: Option<super::spectrum::SpectrumSpec>,

@@ -89,6 +89,9 @@ pub struct RayFileSpec {
     /// Luminous flux (lm), for luminance outputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lumens: Option<f64>,
+    /// The state of the emitted light ([`super::polarization`]); unpolarized without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarization: Option<super::polarization::SourcePolarizationSpec>,
     /// Emission spectrum, for a file without wavelengths ([`super::spectrum`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectrum: Option<SpectrumSpec>,

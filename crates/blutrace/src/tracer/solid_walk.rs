@@ -260,6 +260,8 @@ impl Tracer<'_> {
                 (smooth.leave(surf.normal, dir, light, rng), Feature::Plain)
             }
             _ => {
+                // Walks are not taken when polarization is traced (`Walks::new`).
+                let pol_out = std::cell::Cell::new(None);
                 let at = Arrival {
                     media: &self.scene.media,
                     hit: surf,
@@ -267,6 +269,8 @@ impl Tracer<'_> {
                     medium,
                     est: self.estimator,
                     light,
+                    pol: None,
+                    pol_out: &pol_out,
                 };
                 // No back to choose: a solid's faces are interfaces, which have none
                 // (`optics::two_sided`).

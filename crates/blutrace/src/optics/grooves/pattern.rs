@@ -3,6 +3,7 @@
 
 use crate::optics::density::Gradation;
 use crate::optics::fresnel;
+use crate::optics::polarization::{Polarization, fresnel_roulette};
 use crate::rng::PhotonRng;
 use crate::rounding::floor_i64;
 use glam::DVec3;
@@ -251,18 +252,20 @@ impl GroovePattern {
         dir: DVec3,
         rng: &mut PhotonRng,
     ) -> Option<(DVec3, bool)> {
-        self.scatter_met(indices, point, normal, dir, rng)
+        self.scatter_met(indices, point, normal, dir, None, rng)
             .map(|(d, inside, _)| (d, inside))
     }
 
     /// [`GroovePattern::scatter`], also saying whether the path met a facet of a groove
-    /// (`false`: it met only the flat land between grooves).
+    /// (`false`: it met only the flat land between grooves); `pol`, when polarization is
+    /// traced, is carried through every facet's Fresnel event.
     pub fn scatter_met(
         &self,
         (n_inside, n_outside): (f64, f64),
         point: DVec3,
         normal: DVec3,
         dir: DVec3,
+        mut pol: Option<&mut Polarization>,
         rng: &mut PhotonRng,
     ) -> Option<(DVec3, bool, bool)> {
         let mut met = false;
@@ -322,7 +325,7 @@ impl GroovePattern {
             } else {
                 (n_outside, n_inside, m)
             };
-            match fresnel::roulette(d, facing, n1, n2, rng) {
+            match fresnel_roulette(d, facing, (n1, n2), pol.as_deref_mut(), rng) {
                 Some(t) => {
                     d = t;
                     inside = !inside;

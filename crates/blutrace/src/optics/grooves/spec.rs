@@ -69,8 +69,11 @@ impl Surface for Grooves {
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let i = &self.interface;
         let p = &self.pattern;
-        match p.scatter_met(at.indices(i), at.hit.point, at.hit.normal, at.dir, rng) {
+        let mut pol = at.pol;
+        let (point, normal) = (at.hit.point, at.hit.normal);
+        match p.scatter_met(at.indices(i), point, normal, at.dir, pol.as_mut(), rng) {
             Some((d, inside, met)) => {
+                at.pol_out.set(pol);
                 let feature = if met { Feature::Groove } else { Feature::Plain };
                 (at.lossless(i, (d, inside)), feature)
             }

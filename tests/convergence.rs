@@ -303,6 +303,8 @@ fn metrics_the_plain_way(scene: &Scene, t: &Tally) -> MetricValues {
         Metric::Mean => mean,
         Metric::Efficiency => t.ledger.detected.mean_and_stderr(t.ledger.photons).0,
         Metric::Cv => cv,
+        // A map without light has no uniformity: NaN, not the 0 `max` would make of it.
+        Metric::CvDebiased if (cv * cv - floor * floor).is_nan() => f64::NAN,
         Metric::CvDebiased => (cv * cv - floor * floor).max(0.0).sqrt(),
         Metric::MinOverMax => min_over_max(&mut v.iter().copied()),
         Metric::NinePoint => nine_point,

@@ -409,7 +409,8 @@ fn optimize_exports_virtual_dots_only_as_a_printable_placement() {
         "the files hold the stochastic screen of the surface's seed"
     );
     // A printable surface is exported as traced: asking for another placement is an error.
-    let lattice = support::load(&small_plate("opt-lattice", ""));
+    let lattice_dir = small_plate("opt-lattice", "");
+    let lattice = support::load(&lattice_dir);
     let e = format!("{:#}", optimize(&lattice, &asked, &mut |_| {}).unwrap_err());
     assert!(
         e.contains("option `export_placement` is for virtual patterns"),

@@ -72,7 +72,7 @@ def test_nothing_is_written_over_a_file_the_scene_reads(sheet, tmp_path):
     with pytest.raises(bt.BlutraceError, match="an input of this run"):
         c.write(mesh)
     run = sheet.trace(photons=1000, seed=1)
-    with pytest.raises(bt.BlutraceError, match="sheet.obj"):
+    with pytest.raises(bt.BlutraceError, match="scene.toml, an input of this run"):
         run.write(tmp_path)
     assert mesh.read_text() == OBJ
 

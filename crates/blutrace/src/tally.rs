@@ -680,8 +680,7 @@ impl Tally {
             }
         }
         if let Some(stokes) = &mut self.stokes {
-            for d in &c.detections {
-                let s = d.stokes.unwrap_or_default();
+            for (d, s) in c.detections.iter().zip(&c.stokes) {
                 stokes
                     .iter_mut()
                     .zip(s)
@@ -705,8 +704,6 @@ pub struct Detection {
     pub light: Light,
     /// Whether it left within the detector's luminance cone.
     pub in_cone: bool,
-    /// Its `(S1, S2, S3) / S0` in the detector's frame, when polarization is traced.
-    pub stokes: Option<[f64; 3]>,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between
@@ -717,6 +714,9 @@ pub struct ChunkTally {
     pub index: u64,
     /// Detections, in photon order.
     pub detections: Vec<Detection>,
+    /// Each detection's `(S1, S2, S3) / S0` in the detector's frame, when polarization is
+    /// traced (else empty: kept apart so that a run without it moves no more bytes).
+    pub stokes: Vec<[f64; 3]>,
     /// The chunk's ledger.
     pub ledger: Ledger,
 }

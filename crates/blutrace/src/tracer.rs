@@ -173,11 +173,11 @@ impl<'a> Tracer<'a> {
             }
             if let Some((_, ab)) = detected {
                 let weight = p.light.detected(p.weight);
-                let mut hit = detection(scene, ab, true_ray.dir, weight, p.light);
-                hit.stokes = p
-                    .pol
-                    .map(|pol| scene.detector.stokes_of(&pol, true_ray.dir));
-                out.detections.push(hit);
+                out.detections
+                    .push(detection(scene, ab, true_ray.dir, weight, p.light));
+                if let Some(pol) = &p.pol {
+                    out.stokes.push(scene.detector.stokes_of(pol, true_ray.dir));
+                }
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
@@ -358,6 +358,7 @@ impl<'a> Tracer<'a> {
         let mut out = ChunkTally {
             index,
             detections: Vec::new(),
+            stokes: Vec::new(),
             ledger: Ledger::new(
                 self.scene.tags.len(),
                 self.scene.media.len(),
@@ -508,7 +509,6 @@ fn detection(
         weight,
         light,
         in_cone: d.in_cone(dir),
-        stokes: None,
     }
 }
 

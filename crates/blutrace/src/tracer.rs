@@ -115,8 +115,7 @@ impl<'a> Tracer<'a> {
             estimator,
             convex,
             facets,
-            // The walks' Fresnel events average s and p: not for polarized light.
-            walks: Walks::new(scene, convex && !scene.polarized, &bodies),
+            walks: Walks::new(scene, convex, &bodies),
             bodies,
         }
     }
@@ -523,12 +522,29 @@ fn assert_same_chunks(
     base: impl Fn(&mut Tracer),
     alter: impl FnOnce(&mut Tracer),
 ) -> Vec<ChunkTally> {
+    assert_same_chunks_of(&bundled(name), estimator, base, alter)
+}
+
+/// The bundled scene `name`, for the tracer's tests.
+#[cfg(test)]
+fn bundled(name: &str) -> Scene {
     let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("scenes");
-    let scene = Scene::load(&root.join(name).join("scene.toml")).unwrap();
+    Scene::load(&root.join(name).join("scene.toml")).unwrap()
+}
+
+/// [`assert_same_chunks`] of a loaded `scene` (Stokes vectors compared too).
+#[cfg(test)]
+fn assert_same_chunks_of(
+    scene: &Scene,
+    estimator: Estimator,
+    base: impl Fn(&mut Tracer),
+    alter: impl FnOnce(&mut Tracer),
+) -> Vec<ChunkTally> {
+    let name = &scene.name;
     let accel = crate::accel::build(crate::accel::BackendChoice::Bvh, scene.mesh.clone()).unwrap();
     let facets = scene.mesh.facets();
-    let mut built = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
-    let mut altered = Tracer::new(&scene, accel.as_ref(), estimator, true, &facets);
+    let mut built = Tracer::new(scene, accel.as_ref(), estimator, true, &facets);
+    let mut altered = Tracer::new(scene, accel.as_ref(), estimator, true, &facets);
     base(&mut built);
     base(&mut altered);
     alter(&mut altered);
@@ -538,11 +554,10 @@ fn assert_same_chunks(
                 built.trace_chunk(5, chunk, u64::MAX),
                 altered.trace_chunk(5, chunk, u64::MAX),
             );
-            assert_eq!(a.ledger, b.ledger, "{name} {estimator:?} chunk {chunk}");
-            assert_eq!(
-                a.detections, b.detections,
-                "{name} {estimator:?} chunk {chunk}"
-            );
+            let what = format!("{name} {estimator:?} chunk {chunk}");
+            assert_eq!(a.ledger, b.ledger, "{what}");
+            assert_eq!(a.detections, b.detections, "{what}");
+            assert_eq!(a.stokes, b.stokes, "{what}");
             a
         })
         .into()

@@ -32,6 +32,7 @@ use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::dot_placement::ColumnRadii;
 use crate::optics::dots::DotPattern;
 use crate::optics::fresnel;
+use crate::optics::polarization::{Polarization, fresnel_roulette};
 use crate::optics::lambert;
 use crate::optics::medium::{Interface, MediumId};
 use crate::optics::model::Arrival;
@@ -104,10 +105,14 @@ impl<'a> Walks<'a> {
             (clear && !bodies.any_in(m as MediumId)).then_some(solid)
         };
         let solids: Vec<_> = (0..scene.media.len()).map(walkable).collect();
+        // Runs skip total reflections without turning the polarization they retard.
         let runs = solids
             .iter()
             .enumerate()
-            .map(|(m, s)| TirRun::of(scene, (*s)?, m as MediumId))
+            .map(|(m, s)| match scene.polarized {
+                true => None,
+                false => TirRun::of(scene, (*s)?, m as MediumId),
+            })
             .collect();
         Walks {
             faces,
@@ -160,7 +165,9 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: facet.normal,
             };
-            let (outcome, feature) = self.face_step(tag, &surf, ray.dir, medium, p.light, rng);
+            let light = p.light;
+            let (outcome, feature) =
+                self.face_step(tag, &surf, (ray.dir, medium, light), &mut p.pol, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
             let Outcome::Scattered {
                 dir,
@@ -229,19 +236,21 @@ impl Tracer<'_> {
     /// The face of tag `tag` met at `surf` along `dir` by a photon in `medium`: what
     /// [`SurfaceModel::interact_on`] does (and returns), the guide's two faces taken
     /// directly.
+    /// `pol`, the photon's polarization when it is traced, becomes the light's that leaves.
     fn face_step(
         &self,
         tag: u32,
         surf: &SurfaceHit,
-        dir: DVec3,
-        medium: MediumId,
-        light: Light,
+        (dir, medium, light): (DVec3, MediumId, Light),
+        pol: &mut Option<Polarization>,
         rng: &mut PhotonRng,
     ) -> (Outcome, Feature) {
         // As interact_on and dielectric::scatter decide it (NaN counts as leaving).
         let entering = dir.dot(surf.normal) < 0.0;
         match &self.walks.faces[tag as usize] {
-            Face::Smooth(s) if !entering => (s.leave(surf.normal, dir, light, rng), Feature::Plain),
+            Face::Smooth(s) if !entering => {
+                (s.leave(surf.normal, dir, light, pol, rng), Feature::Plain)
+            }
             Face::Dotted {
                 smooth,
                 pattern,
@@ -255,12 +264,12 @@ impl Tracer<'_> {
                 if ink_met {
                     let albedo = ink_albedo.at(light);
                     let outcome = ink(albedo, -surf.normal, medium, self.estimator, rng);
+                    carry(pol, &outcome, None);
                     return (outcome, Feature::Ink);
                 }
-                (smooth.leave(surf.normal, dir, light, rng), Feature::Plain)
+                (smooth.leave(surf.normal, dir, light, pol, rng), Feature::Plain)
             }
             _ => {
-                // Walks are not taken when polarization is traced (`Walks::new`).
                 let pol_out = std::cell::Cell::new(None);
                 let at = Arrival {
                     media: &self.scene.media,
@@ -269,14 +278,24 @@ impl Tracer<'_> {
                     medium,
                     est: self.estimator,
                     light,
-                    pol: None,
+                    pol: *pol,
                     pol_out: &pol_out,
                 };
                 // No back to choose: a solid's faces are interfaces, which have none
                 // (`optics::two_sided`).
-                self.scene.surfaces[tag as usize].interact_on(&at, rng)
+                let (outcome, feature) = self.scene.surfaces[tag as usize].interact_on(&at, rng);
+                carry(pol, &outcome, pol_out.get());
+                (outcome, feature)
             }
         }
+    }
+}
+
+/// The polarization `pol` (when traced) of light scattered as `outcome`: `kept`, the
+/// state a model gave it, or unpolarized (as the general loop sets it).
+fn carry(pol: &mut Option<Polarization>, outcome: &Outcome, kept: Option<Polarization>) {
+    if let (Some(p), Outcome::Scattered { dir, .. }) = (pol.as_mut(), outcome) {
+        *p = kept.unwrap_or(Polarization::unpolarized(*dir));
     }
 }
 
@@ -285,10 +304,17 @@ impl Smooth {
     /// against the outward `normal`): Fresnel roulette from inside to outside.
     // Always inlined: see the module header (store forwarding).
     #[inline(always)]
-    fn leave(&self, normal: DVec3, dir: DVec3, light: Light, rng: &mut PhotonRng) -> Outcome {
+    fn leave(
+        &self,
+        normal: DVec3,
+        dir: DVec3,
+        light: Light,
+        pol: &mut Option<Polarization>,
+        rng: &mut PhotonRng,
+    ) -> Outcome {
         let facing = -normal;
         let (n1, n2) = (self.n_inside.at(light), self.n_outside.at(light));
-        let (dir, medium) = match fresnel::roulette(dir, facing, n1, n2, rng) {
+        let (dir, medium) = match fresnel_roulette(dir, facing, (n1, n2), pol.as_mut(), rng) {
             Some(t) => (t, self.iface.outside),
             None => (fresnel::reflect(dir, facing), self.iface.inside),
         };
@@ -343,6 +369,24 @@ mod tests {
                     assert!(c.ledger.interactions > 3 * c.ledger.photons, "{name}");
                 }
             }
+        }
+    }
+
+    /// The same with polarization traced: the walk carries the state exactly as the
+    /// general loop does (Stokes vectors of every detection equal too).
+    #[test]
+    fn the_polarized_walk_is_the_general_loop_bit_for_bit() {
+        for name in ["bench-box", "notebook14"] {
+            let mut scene = crate::tracer::bundled(name);
+            scene.polarized = true;
+            let chunks = crate::tracer::assert_same_chunks_of(
+                &scene,
+                Estimator::Analog,
+                |_| {},
+                |general| general.walks.solids.iter_mut().for_each(|s| *s = None),
+            );
+            assert!(chunks.iter().all(|c| c.stokes.len() == c.detections.len()));
+            assert!(chunks.iter().any(|c| c.stokes.iter().any(|s| s[0] != 0.0)));
         }
     }
 }

@@ -32,10 +32,10 @@ use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::dot_placement::ColumnRadii;
 use crate::optics::dots::DotPattern;
 use crate::optics::fresnel;
-use crate::optics::polarization::{Polarization, fresnel_roulette};
 use crate::optics::lambert;
 use crate::optics::medium::{Interface, MediumId};
 use crate::optics::model::Arrival;
+use crate::optics::polarization::{Polarization, fresnel_roulette};
 use crate::optics::spectrum::{Light, Spectral};
 use crate::optics::surface::{Feature, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
@@ -105,14 +105,10 @@ impl<'a> Walks<'a> {
             (clear && !bodies.any_in(m as MediumId)).then_some(solid)
         };
         let solids: Vec<_> = (0..scene.media.len()).map(walkable).collect();
-        // Runs skip total reflections without turning the polarization they retard.
         let runs = solids
             .iter()
             .enumerate()
-            .map(|(m, s)| match scene.polarized {
-                true => None,
-                false => TirRun::of(scene, (*s)?, m as MediumId),
-            })
+            .map(|(m, s)| TirRun::of(scene, (*s)?, m as MediumId))
             .collect();
         Walks {
             faces,
@@ -214,9 +210,13 @@ impl Tracer<'_> {
             (Estimator::Weighted, a) => (p.weight / ROULETTE_BELOW).ln() / a,
         };
         let left = self.scene.max_bounces - *events;
+        let dir = ray.dir;
         let Some(s) = run.skip(ray, p.light, reach, left) else {
             return;
         };
+        if let Some(pol) = &mut p.pol {
+            run.retard(pol, dir, &s, p.light);
+        }
         *events += s.events();
         out.ledger.plain_hits(run.plain_tag, s.plain_hits().into());
         out.ledger.plain_hits(run.dotted_tag, s.periods.into());
@@ -267,7 +267,10 @@ impl Tracer<'_> {
                     carry(pol, &outcome, None);
                     return (outcome, Feature::Ink);
                 }
-                (smooth.leave(surf.normal, dir, light, pol, rng), Feature::Plain)
+                (
+                    smooth.leave(surf.normal, dir, light, pol, rng),
+                    Feature::Plain,
+                )
             }
             _ => {
                 let pol_out = std::cell::Cell::new(None);
@@ -373,16 +376,17 @@ mod tests {
     }
 
     /// The same with polarization traced: the walk carries the state exactly as the
-    /// general loop does (Stokes vectors of every detection equal too).
+    /// general loop does (Stokes vectors of every detection equal too; runs off, as above).
     #[test]
     fn the_polarized_walk_is_the_general_loop_bit_for_bit() {
         for name in ["bench-box", "notebook14"] {
             let mut scene = crate::tracer::bundled(name);
             scene.polarized = true;
+            let no_runs = |t: &mut Tracer| t.walks.runs.iter_mut().for_each(|r| *r = None);
             let chunks = crate::tracer::assert_same_chunks_of(
                 &scene,
                 Estimator::Analog,
-                |_| {},
+                no_runs,
                 |general| general.walks.solids.iter_mut().for_each(|s| *s = None),
             );
             assert!(chunks.iter().all(|c| c.stokes.len() == c.detections.len()));

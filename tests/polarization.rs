@@ -168,6 +168,7 @@ fn two_polarizers_pass_malus_law() {
             assert!((p.s1.value - two.cos()).abs() < 1e-9, "{theta}: {p:?}");
             assert!((p.s2.value + two.sin()).abs() < 1e-9, "{theta}: {p:?}");
             assert!((p.dop.value - 1.0).abs() < 1e-9);
+            assert_stokes_exr(&r, [two.cos(), -two.sin(), 0.0]);
         }
     }
 }
@@ -358,8 +359,9 @@ fn polarized_shards_merge_to_the_single_run_bit_for_bit() {
         .collect();
     let merged = shard::merge(&shards, &scene).unwrap();
     assert_eq!(merged.tally.stokes, single.tally.stokes);
+    let s1 = &single.tally.stokes.as_ref().unwrap()[0];
     assert!(
-        single.tally.stokes.unwrap()[0].0 != 0,
+        s1.bins.iter().any(|b| b.sum.0 != 0),
         "the light is polarized"
     );
     let averaged = std::fs::read_to_string(&*dir).unwrap() + "[trace]\npolarization = false\n";
@@ -371,4 +373,37 @@ fn polarized_shards_merge_to_the_single_run_bit_for_bit() {
     let with = averaged.replace("polarization = false", "polarization = true");
     let on = write_scene("pol-shards-on", &with, &[("cavity.obj", obj.as_str())]);
     assert_ne!(load(&other).content_hash(), load(&on).content_hash());
+}
+
+/// `stokes.exr` of `r`: in every lit bin `S1..S3` over `S0` are `want`, `S0` is flux.exr's
+/// `Y`, and every channel has its standard error.
+fn assert_stokes_exr(r: &RunResult, want: [f64; 3]) {
+    use blutrace::output::exr::read_channels;
+    let dir = support::temp_folder("stokes-exr");
+    let out = dir.path().join("out");
+    r.write(&out).unwrap();
+    let (_, _, channels, _) = read_channels(&out.join("stokes.exr")).unwrap();
+    let (_, _, flux, _) = read_channels(&out.join("flux.exr")).unwrap();
+    let get = |set: &[(String, Vec<f32>)], name: &str| {
+        set.iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+            .unwrap()
+    };
+    let s0 = get(&channels, "S0");
+    assert_eq!(s0, get(&flux, "Y"));
+    for name in ["stderr.S0", "stderr.S1", "stderr.S2", "stderr.S3", "hits"] {
+        assert_eq!(get(&channels, name).len(), s0.len(), "{name}");
+    }
+    let lit: Vec<usize> = (0..s0.len()).filter(|&i| s0[i] > 0.0).collect();
+    assert!(!lit.is_empty());
+    for (k, name) in ["S1", "S2", "S3"].into_iter().enumerate() {
+        let s = get(&channels, name);
+        for &i in &lit {
+            assert!(
+                (f64::from(s[i] / s0[i]) - want[k]).abs() < 1e-5,
+                "{name} bin {i}"
+            );
+        }
+    }
 }

@@ -488,10 +488,10 @@ pub struct Tally {
     /// as the Y tally; else radiant weight), when the sources give lumens or spectra.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cone: Option<Grid>,
-    /// Sums over the detected light of its weight times `S1/S0`, `S2/S0`, `S3/S0` in the
-    /// detector's frame, when polarization is traced.
+    /// Per flux bin, the detected light's weight times `S1/S0`, `S2/S0`, `S3/S0` in the
+    /// detector's frame (sums of either sign), when polarization is traced.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stokes: Option<[ExactSum; 3]>,
+    pub stokes: Option<[Grid; 3]>,
 }
 
 impl Tally {
@@ -507,7 +507,9 @@ impl Tally {
                 .then(|| ColorTally::new(&flux, &angular)),
             cone: (scene.sources.spectral() || scene.sources.luminous_efficacy().is_some())
                 .then(|| Grid::new(flux.nx, flux.ny)),
-            stokes: scene.polarized.then(Default::default),
+            stokes: scene
+                .polarized
+                .then(|| [0, 1, 2].map(|_| Grid::new(d.bins[0], d.bins[1]))),
             flux,
             angular,
             ledger: Ledger::new(
@@ -544,7 +546,12 @@ impl Tally {
             .into_iter()
             .chain(t.color.iter().flat_map(ColorTally::shape))
             .chain(t.cone.iter().map(|g| (g.nx, g.ny, g.bins.len())))
-            .chain(t.stokes.iter().map(|s| (s.len(), 0, 0)))
+            .chain(
+                t.stokes
+                    .iter()
+                    .flatten()
+                    .map(|g| (g.nx, g.ny, g.bins.len())),
+            )
             .collect::<Vec<_>>()
         };
         let sinks = l.absorbed_by_surface.iter().chain(&l.absorbed_in_medium);
@@ -583,13 +590,9 @@ impl Tally {
                 l.checked_accounted()
                     .map_or("more than a tally holds".into(), |a| a.value().to_string())
             )
-        } else if self
-            .stokes
-            .iter()
-            .flatten()
-            .any(|s| s.0.abs() > l.detected.sum.0)
-        {
-            "a Stokes sum exceeds the detected power".into()
+        } else if self.stokes.iter().flatten().any(|g| bad_stokes(g, photons)) {
+            "a Stokes bin holds more than the detected power, or more photons than were emitted"
+                .into()
         } else if negative || l.detected.hits > photons || l.killed_photons > photons {
             "a sink holds negative weight, or more photons than were emitted".into()
         } else if by_source_total != Some(l.detected) {
@@ -623,7 +626,7 @@ impl Tally {
         }
         if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
             for (x, y) in a.iter_mut().zip(b) {
-                *x = x.checked_add(*y)?;
+                x.checked_merge(y)?;
             }
         }
         self.ledger.checked_merge(&o.ledger)
@@ -642,7 +645,7 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
             a.iter_mut()
                 .zip(b)
-                .for_each(|(x, y)| x.merge_signed(*y, sign));
+                .for_each(|(x, y)| x.merge_signed(y, sign));
         }
         self.ledger.merge_signed(&o.ledger, sign);
     }
@@ -681,14 +684,23 @@ impl Tally {
         }
         if let Some(stokes) = &mut self.stokes {
             for (d, s) in c.detections.iter().zip(&c.stokes) {
-                stokes
-                    .iter_mut()
-                    .zip(s)
-                    .for_each(|(sum, k)| sum.add(d.weight * k));
+                for (grid, k) in stokes.iter_mut().zip(s) {
+                    grid.bins[d.flux_bin as usize].add(d.weight * k);
+                }
             }
         }
         self.ledger.merge(&c.ledger);
     }
+}
+
+/// Whether a Stokes grid could not come from a run of `photons` photons: a bin whose
+/// squares sum is negative, whose sum exceeds what its squares allow (`sum^2 <= hits *
+/// sumsq`, Cauchy-Schwarz), or that holds more photons than were emitted.
+fn bad_stokes(g: &Grid, photons: u64) -> bool {
+    g.bins.iter().any(|b| {
+        let (sum, sumsq) = (b.sum.value(), b.sumsq.value());
+        b.sumsq.0 < 0 || b.hits > photons || sum * sum > 1.000001 * sumsq * b.hits as f64
+    })
 }
 
 /// One detected photon.
@@ -738,77 +750,4 @@ impl ChunkTally {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn taking_a_part_out_leaves_exactly_the_rest() {
-        let (mut a, mut b) = (Grid::new(3, 2), Grid::new(3, 2));
-        for k in 0..200 {
-            let w = 1.0 / (k as f64 + 0.37);
-            a.add(k % 3, k % 2, w);
-            b.add((k / 3) % 3, (k / 5) % 2, w * 1e-9);
-        }
-        let mut total = a.clone();
-        total.merge(&b);
-        assert_ne!(total, a);
-        total.merge_signed(&b, Sign::Remove);
-        assert_eq!(total, a);
-    }
-
-    #[test]
-    fn exact_sum_is_order_independent() {
-        let xs: Vec<f64> = (0..10_000).map(|i| 1.0 / (1.0 + i as f64)).collect();
-        let mut fwd = ExactSum::default();
-        xs.iter().for_each(|&x| fwd.add(x));
-        let mut rev = ExactSum::default();
-        xs.iter().rev().for_each(|&x| rev.add(x));
-        assert_eq!(fwd, rev);
-    }
-
-    #[test]
-    fn grid_round_trips_through_json_sparsely() {
-        let mut g = Grid::new(3, 2);
-        g.add(2, 1, 0.75);
-        g.add(2, 1, 1e-12);
-        let json = serde_json::to_string(&g).unwrap();
-        assert_eq!(json.matches('[').count(), 2, "only one bin stored: {json}");
-        let back: Grid = serde_json::from_str(&json).unwrap();
-        assert_eq!(back, g);
-        let bad = json.replace("[[5,", "[[9,");
-        assert!(serde_json::from_str::<Grid>(&bad).is_err());
-    }
-
-    #[test]
-    fn stderr_of_bernoulli_matches_closed_form() {
-        // 1000 samples, 250 ones: p = 0.25, stderr = sqrt(p(1-p)/(n-1)).
-        let (m, s) = mean_and_stderr(250.0, 250.0, 1000);
-        assert_eq!(m, 0.25);
-        assert!((s - (0.25f64 * 0.75 / 999.0).sqrt()).abs() < 1e-15);
-    }
-
-    /// Tallies read from files add up with checked arithmetic: past the `i128` range is
-    /// `None`, never a wrapped sum or a panic.
-    #[test]
-    fn checked_merges_stop_at_the_counters_range() {
-        let mut a = Grid::new(2, 1);
-        let mut b = Grid::new(2, 1);
-        a.bins[1].sum = ExactSum(i128::MAX);
-        b.bins[1].sum = ExactSum(1);
-        assert_eq!(a.checked_merge(&b), None);
-        b.bins[1].sum = ExactSum(0);
-        b.bins[0].hits = 3;
-        assert_eq!(a.checked_merge(&b), Some(()));
-        assert_eq!(a.bins[0].hits, 3);
-        let mut l = Ledger {
-            escaped: ExactSum(i128::MAX),
-            ..Ledger::default()
-        };
-        assert_eq!(l.checked_accounted(), Some(ExactSum(i128::MAX)));
-        l.killed = ExactSum(1);
-        assert_eq!(l.checked_accounted(), None);
-        let mut m = Ledger::default();
-        assert_eq!(m.checked_merge(&l), Some(()));
-        assert_eq!(m.checked_merge(&l), None);
-    }
-}
+mod tests;

@@ -149,6 +149,37 @@ pub(super) fn write_luminance_map(run: &RunResult, staged: &SetDir) -> Result<()
     Ok(())
 }
 
+/// `stokes.exr`, when polarization is traced: `S0` (the flux map) to `S3` per bin with
+/// their standard errors and photons, in the detector's frame.
+pub(super) fn write_stokes_exr(run: &RunResult, staged: &SetDir) -> Result<()> {
+    let Some(maps) = metrics::stokes::stokes_maps(&run.scene, &run.tally) else {
+        return Ok(());
+    };
+    let attrs = map_attributes(
+        run,
+        "W/mm^2",
+        "blutrace Stokes maps: S0..S3 = the Stokes vector's irradiance per bin (W/mm^2; \
+         S0 is flux.exr's Y) in the detector's frame (u = detector_u made perpendicular to \
+         each photon's direction, S1 > 0 along it; v = direction x u), stderr.S0..S3 = \
+         standard errors, hits = photons per bin; x along detector_u, y along detector_v",
+    );
+    let names = ["S0", "S1", "S2", "S3"];
+    let values: Vec<Vec<f32>> = maps.iter().map(|m| f32s(&m.value)).collect();
+    let errors: Vec<Vec<f32>> = maps.iter().map(|m| f32s(&m.stderr)).collect();
+    let stderr_names = names.map(|n| format!("stderr.{n}"));
+    let hits = counts(&maps[0].hits);
+    staged.write_with("stokes.exr", |path| {
+        let mut channels: Vec<(&str, Samples)> = Vec::new();
+        for k in 0..4 {
+            channels.push((names[k], Samples::F32(&values[k])));
+            channels.push((&stderr_names[k], Samples::F32(&errors[k])));
+        }
+        channels.push(("hits", Samples::F32(&hits)));
+        write_channels(path, maps[0].nx, maps[0].ny, &channels, &attrs)
+    })?;
+    Ok(())
+}
+
 /// `flux.exr` of the map `flux`.
 pub(super) fn write_flux_exr(run: &RunResult, staged: &SetDir, flux: &Map) -> Result<()> {
     let attrs = map_attributes(

@@ -472,6 +472,7 @@ impl RunResult {
         images::write_angular_exr(self, staged)?;
         color_images::write_color_images(self, staged)?;
         images::write_luminance_map(self, staged)?;
+        images::write_stokes_exr(self, staged)?;
         staged.write_with("flux.png", |png| images::write_flux_png(self, png, &flux))?;
         staged.write_with("conoscope.png", |png| {
             images::write_conoscope_png(self, png)

@@ -4,11 +4,16 @@
 //!
 //! ```toml
 //! [trace]
-//! polarization = true   # on by default when a surface is a polarizer
+//! polarization = true   # on by default with a polarizer or a polarized source
 //! ```
+//!
+//! Per flux bin too ([`stokes_maps`], `stokes.exr`): `S0` is the flux map, `S1`..`S3`
+//! the irradiance of each Stokes component, each with its per-bin standard error.
 
+use super::Map;
 use super::{Estimate, jackknife_stderr};
-use crate::tally::{ExactSum, Tally};
+use crate::scene::Scene;
+use crate::tally::{ExactSum, Grid, Tally};
 use serde::Serialize;
 
 /// `summary.json`'s `polarization`.
@@ -30,10 +35,33 @@ fn normalised(s: [f64; 3], w: f64) -> [f64; 4] {
     [s1, s2, s3, (s1 * s1 + s2 * s2 + s3 * s3).sqrt()]
 }
 
-/// The sums and detected power of `t` (`None` without polarization).
+/// The sums and detected power of `t` (`None` without polarization): the bins' exact
+/// sums added exactly.
 fn sums(t: &Tally) -> Option<([f64; 3], f64)> {
-    let s = t.stokes?;
-    Some((s.map(ExactSum::value), t.ledger.detected.sum.value()))
+    let grids = t.stokes.as_ref()?;
+    let total = |g: &Grid| {
+        let mut sum = ExactSum::default();
+        g.bins.iter().for_each(|b| sum.merge(b.sum));
+        sum.value()
+    };
+    Some((
+        [total(&grids[0]), total(&grids[1]), total(&grids[2])],
+        t.ledger.detected.sum.value(),
+    ))
+}
+
+/// The maps of `S0` (the flux map) and of `S1`, `S2`, `S3` (W/mm² per bin, each with its
+/// standard error), `None` without polarization.
+pub fn stokes_maps(scene: &Scene, t: &Tally) -> Option<[Map; 4]> {
+    let grids = t.stokes.as_ref()?;
+    let area = scene.detector.bin_area();
+    let map = |g: &Grid| super::grid_map(scene, t, g, |_| area);
+    Some([
+        super::flux_map(scene, t),
+        map(&grids[0]),
+        map(&grids[1]),
+        map(&grids[2]),
+    ])
 }
 
 /// The polarization of the detected light of `total`, errors by the jackknife over

@@ -284,3 +284,51 @@ fn a_spectral_run_reports_its_colour_as_the_summary_has_it() {
         "{line}"
     );
 }
+
+/// A run that traces polarization prints its polarization line: the numbers of
+/// summary.json's `polarization`, value and error of each.
+#[test]
+fn a_polarized_run_reports_its_polarization_as_the_summary_has_it() {
+    let dir = tmp("polarized");
+    let case = std::path::Path::new("tests/corpus/polarizer-without-polarization");
+    for f in ["plate.obj", "film.obj"] {
+        std::fs::copy(case.join(f), dir.path().join(f)).unwrap();
+    }
+    let toml = std::fs::read_to_string(case.join("scene.toml")).unwrap();
+    let toml = toml.replace("polarization = false", "");
+    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
+    let out = dir.path().join("o");
+    let args = [
+        "trace",
+        dir.path().to_str().unwrap(),
+        "--photons",
+        "20000",
+        "--quiet",
+    ];
+    let run = blutrace(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("polarized  "))
+        .unwrap_or_else(|| panic!("no polarization line in {stdout}"));
+    let numbers = line.split(" (detector frame").next().unwrap();
+    let printed: Vec<&str> = numbers
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|w| w.parse::<f64>().is_ok())
+        .collect();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let keys = ["s1", "s2", "s3", "dop"];
+    assert_eq!(printed.len(), 2 * keys.len(), "{line}");
+    for (k, key) in keys.iter().enumerate() {
+        for (j, part) in ["value", "stderr"].iter().enumerate() {
+            let want = s["polarization"][key][part].as_f64().unwrap();
+            assert_eq!(
+                printed[2 * k + j],
+                format!("{want:.4}"),
+                "{key}.{part}: {line}"
+            );
+        }
+    }
+}

@@ -188,10 +188,15 @@ pub(super) fn check(path: &Path, json: bool) -> Result<()> {
         blutrace::run::TALLY_BUDGET_BYTES >> 30
     );
     say!(
-        "trace      {} photons, seed {}, bounce cap {}",
+        "trace      {} photons, seed {}, bounce cap {}; {}",
         scene.default_photons,
         scene.default_seed,
-        scene.max_bounces
+        scene.max_bounces,
+        if scene.polarized {
+            "polarization traced (Stokes vectors, exact Fresnel)"
+        } else {
+            "unpolarized (averaged Fresnel)"
+        }
     );
     for w in &scene.warnings {
         say!("warning    {w}");

@@ -372,6 +372,9 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
     if let Some(c) = &s.color {
         print_colour(c);
     }
+    if let Some(p) = &s.polarization {
+        print_polarization(p);
+    }
     for f in files {
         say!("wrote      {}", f.display());
     }
@@ -393,6 +396,21 @@ fn print_colour(c: &blutrace::run::metrics::color::ColorSummary) {
         num(&c.y, 4),
         num(&c.cct_k, 0),
         num(&c.delta_uv_13pt_debiased, 4)
+    );
+}
+
+/// The polarization line of a run that traces it: the target light's normalised Stokes
+/// vector and degree of polarization, each with its error, as summary.json has them.
+fn print_polarization(p: &blutrace::run::metrics::stokes::PolarizationSummary) {
+    let num = |e: &blutrace::run::metrics::Estimate| {
+        format!("{} ± {}", err(e.value, 4, false), err(e.stderr, 4, false))
+    };
+    say!(
+        "polarized  S1/S0 {}, S2/S0 {}, S3/S0 {}, degree {} (detector frame, S1 > 0 along u)",
+        num(&p.s1),
+        num(&p.s2),
+        num(&p.s3),
+        num(&p.dop)
     );
 }
 

@@ -178,6 +178,7 @@ impl Scene {
         )?;
         let polarized = traces_polarization(&ctx, file, (&surfaces, &backs), &sources)?;
         let detector = file.detector.build(&ctx)?;
+        warnings.extend(detector.coarse_warning());
         if file.trace.photons == 0 {
             return Err(ctx.err("trace.photons", "must be at least 1"));
         }

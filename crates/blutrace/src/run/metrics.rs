@@ -510,7 +510,7 @@ mod tests {
         assert!(u.cv > 0.0, "{u:?}");
         assert!(u.nine_point_min_over_max.is_nan(), "{u:?}");
         assert!(u.thirteen_point_min_over_max.is_nan(), "{u:?}");
-        let strips = Uniformity::of(&map(2, 4, vec![1.0, 3.0].repeat(4)));
+        let strips = Uniformity::of(&map(2, 4, [1.0, 3.0].repeat(4)));
         assert!(strips.nine_point_min_over_max.is_nan(), "{strips:?}");
 
         let one = Uniformity::of(&map(1, 1, vec![2.0]));

@@ -137,6 +137,11 @@ impl SourceSpec {
         }
     }
 
+    /// Whether the entry gives a polarization (then the scene traces it, unless told not to).
+    pub fn is_polarized(&self) -> bool {
+        self.common().polarization.is_some()
+    }
+
     /// Whether the entry gives an emission spectrum (then the scene is spectral).
     pub fn has_spectrum(&self) -> bool {
         self.common().spectrum.is_some()

@@ -137,6 +137,25 @@ fn a_polarized_source_starts_its_photons_in_its_state() {
         (p.s1.value - 0.5).abs() < 1e-9 && (p.s2.value - s2).abs() < 1e-9,
         "{p:?}"
     );
+    // Told not to trace polarization, the source's light starts unpolarized: it says so
+    // (it said nothing, and the state given was silently dropped).
+    let off = format!("{state}\n[trace]\npolarization = false");
+    let r = polarized_beam(
+        &sheet("film", -10.0, 1.0, 0),
+        aside,
+        &off,
+        "source-off",
+        1_000,
+    );
+    let s = r.summary();
+    assert!(s.polarization.is_none());
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.starts_with("sources[0].polarization is not traced")),
+        "{:?}",
+        s.warnings
+    );
 }
 
 fn polarizer(tag: &str, axis_deg: f64, block_reflectance: f64) -> String {

@@ -18,6 +18,7 @@ use blutrace::optimize::{
     LayoutResult, OptimizeOptions, OptimizeResult, VerifiedDesign, optimize, optimize_layout,
 };
 use blutrace::scene::Scene;
+use blutrace::spec_check::short;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -220,12 +221,12 @@ pub fn print_layout_report(r: &LayoutResult) {
     }
     for v in &r.variables {
         say!(
-            "variable   {} = {} -> {:.4} (range {}..{})",
+            "variable   {} = {} -> {} (range {}..{})",
             v.name,
-            v.initial,
-            v.final_value,
-            v.min,
-            v.max
+            short(v.initial),
+            short4(v.final_value),
+            short(v.min),
+            short(v.max)
         );
         if let Some(end) = v.at_range_end() {
             say!(
@@ -363,4 +364,10 @@ pub fn print_report(r: &OptimizeResult) {
         print_verified("  initial", &v.initial, m);
         print_verified("  final", &v.final_design, m);
     }
+}
+
+/// `x` with 4 decimals, or short (`1e300`) when that is long: a varied number's result.
+fn short4(x: f64) -> String {
+    let fixed = format!("{x:.4}");
+    if fixed.len() <= 16 { fixed } else { short(x) }
 }

@@ -193,6 +193,24 @@ impl TargetPlane {
         self.size[0] * self.size[1] * 1e-6
     }
 
+    /// The warning of a flux map too coarse for some uniformity metrics (they are null):
+    /// one bin has no spread (cv, min/max), and a side of 2 bins no distinct 9- and
+    /// 13-point spots ([`crate::run::metrics::spots_apart`]).
+    pub fn coarse_warning(&self) -> Option<String> {
+        let [nx, ny] = self.bins;
+        let apart = crate::run::metrics::spots_apart;
+        let what = if nx * ny == 1 {
+            "its cv, min/max and 9- and 13-point ratios are null"
+        } else if !(apart(nx) && apart(ny)) {
+            "its 9- and 13-point ratios are null (their 3x3-bin spots about the points at 1/6, 1/2 and 5/6 of a side of 2 bins all cover both)"
+        } else {
+            return None;
+        };
+        Some(format!(
+            "detector.bins = [{nx}, {ny}]: the flux map is too coarse to measure all of its uniformity: {what}, not those of a perfectly uniform map"
+        ))
+    }
+
     /// Centre of bin `(ix, iy)` of an `nx` x `ny` grid over the target (the detector's
     /// own flux bins, or a map of another resolution).
     pub fn grid_centre(&self, [nx, ny]: [usize; 2], ix: usize, iy: usize) -> DVec3 {

@@ -45,7 +45,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 /// `[[sources]]`: a light source in the scene file.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Serialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum SourceSpec {
     /// Cold-cathode fluorescent lamp: a Lambertian cylinder ([`ccfl`]).
@@ -54,6 +54,34 @@ pub enum SourceSpec {
     Led(LedSpec),
     /// Rays from a TM-25 or text ray file ([`rayfile`]).
     Rayfile(RayFileSpec),
+}
+
+impl<'de> Deserialize<'de> for SourceSpec {
+    /// `type` picks the source, whose spec reads the rest of the table: an error names
+    /// the key it is about (serde's `tag = "type"` reading loses it).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use crate::spec_check::keyed;
+        use serde::de::Error;
+        let mut table = toml::Table::deserialize(d)?;
+        let kind = match table.remove("type") {
+            Some(toml::Value::String(s)) => s,
+            Some(other) => {
+                return Err(D::Error::custom(format!(
+                    "type: expected \"ccfl\", \"led\" or \"rayfile\", got {other}"
+                )));
+            }
+            None => return Err(D::Error::missing_field("type")),
+        };
+        match kind.as_str() {
+            "ccfl" => keyed(&table).map(SourceSpec::Ccfl),
+            "led" => keyed(&table).map(SourceSpec::Led),
+            "rayfile" => keyed(&table).map(SourceSpec::Rayfile),
+            other => Err(format!(
+                "unknown variant `{other}`, expected one of `ccfl`, `led`, `rayfile` in `type`"
+            )),
+        }
+        .map_err(D::Error::custom)
+    }
 }
 
 /// What every source entry gives besides its emitting shape.
@@ -107,6 +135,11 @@ impl SourceSpec {
             SourceSpec::Led(_) => "led",
             SourceSpec::Rayfile(_) => "rayfile",
         }
+    }
+
+    /// Whether the entry gives a polarization (then the scene traces it, unless told not to).
+    pub fn is_polarized(&self) -> bool {
+        self.common().polarization.is_some()
     }
 
     /// Whether the entry gives an emission spectrum (then the scene is spectral).
@@ -546,6 +579,55 @@ fn check_spectra(ctx: &Ctx, list: &[Source], entry: &[usize]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn parse(extra: &str) -> Result<SourceSpec, String> {
+        let text = format!(
+            "type = \"led\"\ncenter = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\nu = [0.0, 1.0, 0.0]\nwidth_mm = 1.0\nheight_mm = 1.0\npower_w = 1.0\n{extra}"
+        );
+        toml::from_str::<SourceSpec>(&text).map_err(|e| e.to_string())
+    }
+
+    /// A wrong value of a source's key names the key (serde's `type`-tagged reading lost
+    /// it: `invalid type: string "30", expected f64`, or `expected struct Keys`), and a
+    /// polarization angle past a thousand turns is refused as rotations are.
+    #[test]
+    fn wrong_source_values_name_their_key() {
+        let e = parse("polarization = { linear_deg = \"30\" }\n").unwrap_err();
+        assert!(
+            e.contains("polarization.linear_deg: invalid type: string"),
+            "{e}"
+        );
+        let e = parse("polarization = true\n").unwrap_err();
+        assert!(
+            e.contains("polarization: invalid type: boolean `true`, expected a table"),
+            "{e}"
+        );
+        assert!(!e.contains("struct Keys"), "{e}");
+        let e = parse("lumens = \"x\"\n").unwrap_err();
+        assert!(e.contains("lumens: invalid type"), "{e}");
+        let e = parse("").unwrap();
+        assert_eq!(e.kind(), "led");
+        let e = toml::from_str::<SourceSpec>("type = \"lde\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown variant `lde`"), "{e}");
+        let e = toml::from_str::<SourceSpec>("power_w = 1.0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing field `type`"), "{e}");
+
+        let ctx = crate::spec_check::Ctx(std::path::Path::new("scene.toml"));
+        let pol = |deg: f64| {
+            polarization::SourcePolarizationSpec::Linear { linear_deg: deg }
+                .build(&ctx, "sources[0].polarization")
+        };
+        let e = format!("{:#}", pol(1e300).unwrap_err());
+        assert!(
+            e.contains("sources[0].polarization.linear_deg: must be within ±3.6e5 degrees"),
+            "{e}"
+        );
+        assert!(pol(-3.6e5).is_ok() && pol(30.0).is_ok());
+    }
 
     #[test]
     fn sources_are_picked_by_power() {

@@ -168,3 +168,41 @@ pub fn short(x: f64) -> String {
         None => plain,
     }
 }
+
+/// `T` read from `table`, an error prefixed by the key it is about (`albedo: invalid
+/// type: ...`): the table is read again from its own TOML text, whose error has the
+/// place of the key or value it is about. For the tables serde's tagged enums read
+/// (`[surfaces.TAG]` by `model`, `[[sources]]` by `type`), whose errors lose the key.
+pub fn keyed<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
+    let text = toml::to_string(table).map_err(|e| e.to_string())?;
+    toml::from_str::<T>(&text).map_err(|e| {
+        let missing = e.message().starts_with("missing field");
+        match e.span().filter(|_| !missing).and_then(|s| key_at(&text, s)) {
+            Some(key) => format!("{key}: {}", e.message()),
+            None => e.message().to_string(),
+        }
+    })
+}
+
+/// The dotted key of the `key = value` line that holds all of `span` in the TOML `text`
+/// (`None` for an empty span or one over several lines).
+fn key_at(text: &str, span: std::ops::Range<usize>) -> Option<String> {
+    if span.is_empty() {
+        return None;
+    }
+    let start = text.get(..span.start)?.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?;
+    if span.end > start + line.len() || line.starts_with('[') {
+        return None;
+    }
+    let key = line.split_once('=')?.0.trim().trim_matches('"');
+    let section = text[..start]
+        .lines()
+        .rev()
+        .find(|l| l.starts_with('['))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
+    Some(match section {
+        Some(s) => format!("{s}.{key}"),
+        None => key.to_string(),
+    })
+}

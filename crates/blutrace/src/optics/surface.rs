@@ -102,6 +102,19 @@ macro_rules! surface_models {
         }
 
         impl SurfaceSpec {
+            /// Read a `[surfaces.TAG]` table (`model` and the model's keys); an error
+            /// names the key it is about (serde's `tag = "model"` reading loses it).
+            pub fn from_table(mut table: toml::Table) -> Result<SurfaceSpec, String> {
+                let model = table.get("model").and_then(toml::Value::as_str).map(str::to_owned);
+                match model.as_deref() {
+                    $( Some($name) => {
+                        table.remove("model");
+                        crate::spec_check::keyed::<$Spec>(&table).map(SurfaceSpec::$Variant)
+                    } )*
+                    _ => SurfaceSpec::deserialize(toml::Value::Table(table)).map_err(|e| e.to_string()),
+                }
+            }
+
             /// Check the table at `at` (`surfaces.TAG`, or a lamp's `sources[i].body`) and
             /// build its model.
             pub fn build(&self, ctx: &Ctx, at: &str, media: &[Medium]) -> Result<SurfaceModel> {

@@ -49,7 +49,7 @@ impl<'de> Deserialize<'de> for SurfaceEntry {
             .remove("back")
             .map(|v| OpaqueSpec::deserialize(v).map_err(|e| D::Error::custom(format!("back: {e}"))))
             .transpose()?;
-        let spec = SurfaceSpec::deserialize(toml::Value::Table(table)).map_err(D::Error::custom)?;
+        let spec = SurfaceSpec::from_table(table).map_err(D::Error::custom)?;
         Ok(SurfaceEntry { spec, back })
     }
 }
@@ -167,6 +167,30 @@ mod tests {
         let plain = parse("[s]\nmodel = \"mirror\"\n").unwrap();
         assert!(plain.back.is_none());
         assert!(plain.build(&ctx, "surfaces.s", &[]).unwrap().1.is_none());
+    }
+
+    /// A wrong value of a model's key names the key (the table's line alone left the
+    /// user to guess which of its keys); a missing key is named by serde itself.
+    #[test]
+    fn wrong_values_name_their_key() {
+        let polarizer = "[s]\nmodel = \"polarizer\"\naxis = [1.0, 0.0, 0.0]\nblock_transmittance = 0.0\nblock_reflectance = 0.9\n";
+        let e = parse(&format!("{polarizer}pass_transmittance = \"0.9\"\n")).unwrap_err();
+        assert!(
+            e.contains("pass_transmittance: invalid type: string"),
+            "{e}"
+        );
+        let e = parse("[s]\nmodel = \"lambert\"\nalbedo = \"x\"\n").unwrap_err();
+        assert!(e.contains("albedo: invalid type"), "{e}");
+        let e = parse(&polarizer.replace("[1.0, 0.0, 0.0]", "[1.0, 0.0]")).unwrap_err();
+        assert!(e.contains("axis: invalid length 2"), "{e}");
+        let e = parse(&polarizer.replace("axis = [1.0, 0.0, 0.0]\n", "")).unwrap_err();
+        assert!(
+            e.contains("missing field `axis`") && !e.contains(": missing"),
+            "{e}"
+        );
+        let e = parse("[s]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"hex\"\npitch_mm = 1.0\norigin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 10.0\ndensity_grid = { width_mm = 1.0, v_min_mm = 0.0, values = [[\"a\"]] }\n").unwrap_err();
+        assert!(e.contains("density_grid.values: invalid type"), "{e}");
+        assert!(parse(&format!("{polarizer}pass_transmittance = 0.9\n")).is_ok());
     }
 
     #[test]

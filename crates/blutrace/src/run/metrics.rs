@@ -12,7 +12,10 @@
 //!
 //! A map that no photon reached has no uniformity: its cv, debiased cv, noise floor and
 //! ratios are NaN (`null` in summary.json), never the 0 of a perfectly uniform map, and
-//! the optimizers rank such a design infeasible.
+//! the optimizers rank such a design infeasible. So are the cv and min/max of a map of
+//! one bin, and the 9- and 13-point ratios of a map with 2 bins along a side (their
+//! spots all cover both, [`spots_apart`]): a map too coarse to measure them is not a
+//! perfectly uniform one.
 
 pub mod color;
 pub mod cone;
@@ -27,6 +30,14 @@ pub use jackknife::{
 use crate::scene::Scene;
 use crate::tally::{BinStats, Grid, Tally};
 use serde::Serialize;
+
+/// Whether the 9- and 13-point spots (3x3 bins about the points at 1/6, 1/2 and 5/6 of
+/// a side) tell a side of `n` bins apart: not on 2 bins, where every spot covers both
+/// and hides the variation the map resolves (a side of 1 bin resolves none: a profile
+/// map's ratio is the one along its other side).
+pub fn spots_apart(n: usize) -> bool {
+    n != 2
+}
 
 /// Number of interleaved photon groups kept for jackknife errors.
 pub const GROUPS: usize = 32;
@@ -189,17 +200,26 @@ impl Uniformity {
         let points = thirteen_points();
         let spot =
             |pts: &[(f64, f64)]| min_over_max(pts.iter().map(|&(x, y)| spot_mean(nx, ny, v, x, y)));
-        let nine_point = spot(&points[..9]);
+        // A map of one bin has no spread to measure, and the 3x3-bin spots about the
+        // points at 1/6, 1/2 and 5/6 of a side of 2 bins all cover both: those metrics
+        // are NaN there, never the 0 or 1 of a perfectly uniform map.
+        let spread = v.len() > 1;
+        let spots = spread && spots_apart(nx) && spots_apart(ny);
+        let nine_point = if spots { spot(&points[..9]) } else { f64::NAN };
         Uniformity {
             mean,
-            cv: if mean > 0.0 {
+            cv: if mean > 0.0 && spread {
                 var.sqrt() / mean
             } else {
                 f64::NAN
             },
-            min_over_max: ratio(sums.lo, sums.hi),
+            min_over_max: if spread {
+                ratio(sums.lo, sums.hi)
+            } else {
+                f64::NAN
+            },
             nine_point_min_over_max: nine_point,
-            thirteen_point_min_over_max: spot(&points),
+            thirteen_point_min_over_max: if spots { spot(&points) } else { f64::NAN },
         }
     }
 }
@@ -463,4 +483,46 @@ struct FluxValues {
     ny: usize,
     value: Vec<f64>,
     stderr: Vec<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(nx: usize, ny: usize, value: Vec<f64>) -> Map {
+        let n = value.len();
+        Map {
+            nx,
+            ny,
+            stderr: vec![0.0; n],
+            hits: vec![1; n],
+            value,
+        }
+    }
+
+    /// A map too coarse to measure a metric gives no value (NaN), never the 1 or 0 of a
+    /// perfectly uniform map: the 9- and 13-point spots of a 2 x 2 map all cover the
+    /// whole map, and one bin has no spread.
+    #[test]
+    fn coarse_maps_measure_no_uniformity_they_cannot_see() {
+        let u = Uniformity::of(&map(2, 2, vec![1.0, 3.0, 1.0, 3.0]));
+        assert!((u.min_over_max - 1.0 / 3.0).abs() < 1e-12, "{u:?}");
+        assert!(u.cv > 0.0, "{u:?}");
+        assert!(u.nine_point_min_over_max.is_nan(), "{u:?}");
+        assert!(u.thirteen_point_min_over_max.is_nan(), "{u:?}");
+        let strips = Uniformity::of(&map(2, 4, [1.0, 3.0].repeat(4)));
+        assert!(strips.nine_point_min_over_max.is_nan(), "{strips:?}");
+
+        let one = Uniformity::of(&map(1, 1, vec![2.0]));
+        assert_eq!(one.mean, 2.0);
+        assert!(one.cv.is_nan() && one.min_over_max.is_nan(), "{one:?}");
+        assert!(one.nine_point_min_over_max.is_nan(), "{one:?}");
+
+        // A profile map (one bin across) keeps its ratio along the other side.
+        let profile = Uniformity::of(&map(20, 1, (1..=20).map(f64::from).collect()));
+        assert!(profile.nine_point_min_over_max > 0.0, "{profile:?}");
+        let fine = Uniformity::of(&map(3, 3, vec![1.0; 9]));
+        assert_eq!(fine.nine_point_min_over_max, 1.0);
+        assert_eq!(fine.cv, 0.0);
+    }
 }

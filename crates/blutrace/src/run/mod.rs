@@ -369,13 +369,22 @@ pub fn trace_reusing(
         bail!("option `threads` must be within 1..={MAX_THREADS}, got {n}");
     }
     check_tally_budget(scene)?;
-    if options.target_error.is_some()
-        && options.target_metric == TargetMetric::Cv
-        && scene.detector.bins[0] * scene.detector.bins[1] == 1
-    {
+    let [nx, ny] = scene.detector.bins;
+    let (one_bin, spots) = (
+        nx * ny == 1,
+        metrics::spots_apart(nx) && metrics::spots_apart(ny),
+    );
+    let undefined = match options.target_metric {
+        TargetMetric::Cv => one_bin,
+        TargetMetric::NinePoint | TargetMetric::ThirteenPoint => one_bin || !spots,
+        _ => false,
+    };
+    if options.target_error.is_some() && undefined {
+        let m = options.target_metric.metric().name();
         bail!(
-            "{}: detector.bins is [1, 1]: the cv of a one-bin map is 0 by construction, so \
-             option `target_metric` cv can never reach a relative error",
+            "{}: detector.bins is [{nx}, {ny}]: a map this coarse has no {m} (a one-bin map has \
+             no spread, the 9- and 13-point spots of a side of 2 bins all cover both), so \
+             option `target_metric` {m} can never reach a relative error",
             scene.path.display()
         );
     }

@@ -92,7 +92,8 @@ impl Scene {
                 _ => value.clone(),
             };
         }
-        Scene::from_source(doc, &self.path).with_context(|| format!("with {key} = {value}"))
+        Scene::from_source(doc, &self.path)
+            .with_context(|| format!("with {key} = {}", shown(&value)))
     }
 
     /// `key` in this scene's file, for messages.
@@ -219,6 +220,15 @@ fn show_or_root(path: &[Step]) -> String {
     }
 }
 
+/// `value` as TOML for a message, its numbers short (`1e300`, not 301 digits).
+fn shown(value: &Value) -> String {
+    match value {
+        Value::Float(x) => crate::spec_check::short(*x),
+        Value::Array(a) => format!("[{}]", a.iter().map(shown).collect::<Vec<_>>().join(", ")),
+        other => other.to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,5 +255,20 @@ mod tests {
             let e = format!("{:#}", resolve(&d, key).unwrap_err());
             assert!(e.contains(says), "{key}: {e}");
         }
+    }
+
+    /// A value in a message prints short: `set("...power_w", 1e300)` said
+    /// `with sources.0.power_w = 1000...` in 301 digits.
+    #[test]
+    fn values_in_messages_print_short() {
+        assert_eq!(shown(&Value::Float(1e300)), "1e300");
+        assert_eq!(shown(&Value::Float(-2.5e-300)), "-2.5e-300");
+        let a = Value::Array(vec![
+            Value::Float(1e300),
+            Value::Integer(3),
+            Value::Float(0.5),
+        ]);
+        assert_eq!(shown(&a), "[1e300, 3, 0.5]");
+        assert_eq!(shown(&Value::String("x".into())), "\"x\"");
     }
 }

@@ -177,7 +177,11 @@ impl Scene {
             &sources.list,
         )?;
         let polarized = traces_polarization(&ctx, file, (&surfaces, &backs), &sources)?;
+        if !polarized {
+            warnings.extend(unpolarized_sources(file));
+        }
         let detector = file.detector.build(&ctx)?;
+        warnings.extend(detector.coarse_warning());
         if file.trace.photons == 0 {
             return Err(ctx.err("trace.photons", "must be at least 1"));
         }
@@ -554,6 +558,23 @@ fn fit_models_to_faces(
         s.fit_to_face(ctx, &format!("surfaces.{}", tags[tag_id]), &face)?;
     }
     Ok(())
+}
+
+/// The warnings of polarized sources in a scene that does not trace polarization
+/// (`[trace] polarization = false`): their light starts unpolarized.
+fn unpolarized_sources(file: &SceneFile) -> Vec<String> {
+    let polarized = file
+        .sources
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_polarized());
+    polarized
+        .map(|(i, _)| {
+            format!(
+                "sources[{i}].polarization is not traced: [trace] polarization = false averages every photon's state, so the source's light starts unpolarized"
+            )
+        })
+        .collect()
 }
 
 /// Whether the scene traces polarization: `[trace] polarization`, else whether a surface

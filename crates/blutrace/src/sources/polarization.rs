@@ -37,7 +37,10 @@ pub enum SourcePolarizationSpec {
 
 /// The table as written, so that an unknown or missing key gets a message naming the keys.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table { linear_deg = D } or { stokes = [S0, S1, S2, S3] }"
+)]
 struct Keys {
     linear_deg: Option<f64>,
     stokes: Option<[f64; 4]>,
@@ -63,7 +66,18 @@ impl SourcePolarizationSpec {
     pub fn build(&self, ctx: &Ctx, field: &str) -> Result<Stokes> {
         match *self {
             SourcePolarizationSpec::Linear { linear_deg } => {
-                let deg = ctx.finite(&format!("{field}.linear_deg"), linear_deg)?;
+                let at = format!("{field}.linear_deg");
+                let deg = ctx.finite(&at, linear_deg)?;
+                let max = crate::spec_check::MAX_ANGLE_DEG;
+                if deg.abs() > max {
+                    return Err(ctx.err(
+                        &at,
+                        format!(
+                            "must be within ±{max:e} degrees (a thousand turns and more is a typing mistake), got {}",
+                            crate::spec_check::short(deg)
+                        ),
+                    ));
+                }
                 Ok(Stokes::linear_deg(deg))
             }
             SourcePolarizationSpec::Stokes { stokes } => {

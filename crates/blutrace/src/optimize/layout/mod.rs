@@ -41,6 +41,7 @@ use super::nelder_mead::{self, Settings};
 use super::{Method, OptimizeOptions};
 use crate::run::is_interrupted;
 use crate::scene::Scene;
+use crate::spec_check::short;
 use anyhow::{Result, bail};
 use search::LayoutSearch;
 use std::collections::HashMap;
@@ -126,9 +127,9 @@ fn resolve_variables(doc: &Value, options: &OptimizeOptions) -> Result<Vec<Varia
             bail!(
                 "option `vary` {}: the scene's value {} is outside {}..{} (the search starts from the scene's design)",
                 v.name,
-                v.initial,
-                v.min,
-                v.max
+                short(v.initial),
+                short(v.min),
+                short(v.max)
             );
         }
     }

@@ -56,7 +56,9 @@ impl std::str::FromStr for VarySpec {
         let (min, max) = (number(lo)?, number(hi)?);
         if min >= max {
             return Err(format!(
-                "{key}: the range {min}..{max} is empty or inverted"
+                "{key}: the range {}..{} is empty or inverted",
+                crate::spec_check::short(min),
+                crate::spec_check::short(max)
             ));
         }
         Ok(VarySpec {
@@ -124,8 +126,8 @@ impl Variable {
         if integer && spec.min.ceil() > spec.max.floor() {
             bail!(
                 "option `vary` {key}: an integer field, and {}..{} holds no integer",
-                spec.min,
-                spec.max
+                crate::spec_check::short(spec.min),
+                crate::spec_check::short(spec.max)
             );
         }
         Ok(Variable {

@@ -26,6 +26,18 @@ pub(super) fn check_scenes(scene: &Path, box_scene: &Path) -> Result<()> {
     Ok(())
 }
 
+/// `--threads` is within the bounds a run takes before any pool is built: the tables build
+/// their own thread pools first, and 100000 threads hung the machine instead of an error.
+pub(super) fn check_threads(threads: Option<usize>) -> Result<()> {
+    use blutrace::run::MAX_THREADS;
+    if let Some(n) = threads
+        && !(1..=MAX_THREADS).contains(&n)
+    {
+        bail!("--threads must be within 1..={MAX_THREADS}, got {n}");
+    }
+    Ok(())
+}
+
 /// Stop a benchmark whose stdout's reader has gone: its tables are all it makes.
 fn reader_still_there() -> Result<()> {
     if super::stdout_closed() {

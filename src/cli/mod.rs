@@ -180,6 +180,7 @@ impl Command {
             } => {
                 let box_scene = box_scene
                     .unwrap_or_else(|| scene.parent().unwrap_or(Path::new(".")).join("bench-box"));
+                bench::check_threads(threads)?;
                 bench::check_scenes(&scene, &box_scene)?;
                 bench::bench(&scene, &box_scene, photons, threads, repeat)
             }

@@ -35,7 +35,7 @@ use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::polarization::{Polarization, fresnel_roulette};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::Result;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -93,7 +93,10 @@ impl SurfaceSpecOf for DiffuserSpec {
         if alpha > MAX_ROUGHNESS {
             return Err(ctx.err(
                 &field,
-                format!("must be at most {MAX_ROUGHNESS} (GGX alpha), got {alpha}"),
+                format!(
+                    "must be at most {MAX_ROUGHNESS} (GGX alpha), got {}",
+                    short(alpha)
+                ),
             ));
         }
         Ok(Diffuser {

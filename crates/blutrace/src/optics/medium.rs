@@ -35,7 +35,7 @@ pub use super::particles::{MAX_VOLUME_FRACTION, ParticlesSpec};
 use super::phase::{self, PhaseTable};
 use super::sampling;
 use super::spectrum::{Light, Range, Spectral, SpectralValue};
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::Result;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -244,7 +244,7 @@ impl MediumSpec {
         if g.abs() >= 1.0 {
             return Err(ctx.err(
                 &field("anisotropy"),
-                format!("must be within (-1, 1), got {g}"),
+                format!("must be within (-1, 1), got {}", short(g)),
             ));
         }
         let mut scattering = Scattering {

@@ -9,7 +9,7 @@
 //!
 //! Any registered model whose light stays on its side may stand here, with the fields it
 //! has in `[surfaces.*]`; one that lets light through (a dielectric, dots, grooves, a
-//! diffuser) is refused, naming the field.
+//! diffuser, a polarizer) is refused, naming the field.
 
 use super::absorber::Absorber;
 use super::medium::Medium;
@@ -79,7 +79,7 @@ impl OpaqueSpec {
             OpaqueSpec::Model(spec) => spec,
         };
         let model = spec.build(ctx, at, media)?;
-        if model.interface().is_some() {
+        if model.lets_light_through() {
             return Err(ctx.err(
                 &format!("{at}.model"),
                 format!(

@@ -19,7 +19,7 @@
 
 use super::mie::{self, BulkSpectra};
 use super::spectrum::{Light, Range, Spectral, SpectralValue};
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
@@ -88,7 +88,7 @@ impl ParticlesSpec {
         if r > 1e4 {
             return Err(ctx.err(
                 &f("radius_um"),
-                format!("must be at most 1e4 um (10 mm), got {r}"),
+                format!("must be at most 1e4 um (10 mm), got {}", short(r)),
             ));
         }
         let n_p = self.n.build(ctx, &f("n"), Range::Index)?;
@@ -120,7 +120,8 @@ impl ParticlesSpec {
                 field,
                 format!(
                     "must be at most {MAX_VOLUME_FRACTION} (beyond it particles scatter \
-                     dependently, which the Mie sum does not describe), got {fv}"
+                     dependently, which the Mie sum does not describe), got {}",
+                    short(fv)
                 ),
             ));
         }

@@ -158,6 +158,13 @@ surface_models! {
 }
 
 impl SurfaceModel {
+    /// Whether light can cross the face: a dielectric-like model, or a polarizer sheet
+    /// (the same medium on both sides, so no [`SurfaceModel::interface`], yet it
+    /// transmits). Such a model cannot be a lamp body or a surface's back.
+    pub fn lets_light_through(&self) -> bool {
+        self.interface().is_some() || matches!(self, SurfaceModel::Polarizer(_))
+    }
+
     /// Roulette the fate of a photon of monochrome light arriving along `dir` in `medium`
     /// at `hit` (the tracer's photons carry their light: [`SurfaceModel::interact_on`]).
     #[inline]

@@ -66,11 +66,11 @@ impl SurfaceEntry {
         let Some(back) = &self.back else {
             return Ok((front, None));
         };
-        if front.interface().is_some() {
+        if front.lets_light_through() {
             return Err(ctx.err(
                 &format!("{at}.back"),
                 format!(
-                    "'{}' lets light through: its two sides are its media, it has no back (back is for lambert, phong, mirror or absorber)",
+                    "'{}' lets light through: light crosses it to its other side, it has no back (back is for lambert, phong, mirror or absorber)",
                     front.kind()
                 ),
             ));
@@ -191,6 +191,37 @@ mod tests {
         let e = parse("[s]\nmodel = \"dots\"\ninside = \"pmma\"\nink_albedo = 0.9\nlattice = \"hex\"\npitch_mm = 1.0\norigin = [0.0, 0.0, 0.0]\naxis = [1.0, 0.0, 0.0]\nlength_mm = 10.0\ndensity_grid = { width_mm = 1.0, v_min_mm = 0.0, values = [[\"a\"]] }\n").unwrap_err();
         assert!(e.contains("density_grid.values: invalid type"), "{e}");
         assert!(parse(&format!("{polarizer}pass_transmittance = 0.9\n")).is_ok());
+    }
+
+    /// A polarizer lets light through (with the same medium on both sides, so it has no
+    /// interface): it has no back, and it is no back (the audit's third pass found both
+    /// taken, a photon from behind meeting an absorber or a sheet that transmits).
+    #[test]
+    fn a_polarizer_has_no_back_and_is_none() {
+        let ctx = Ctx(Path::new("scene.toml"));
+        let sheet = "model = \"polarizer\", axis = [1.0, 0.0, 0.0], pass_transmittance = 0.9, block_transmittance = 0.0, block_reflectance = 0.9";
+        let lines = "model = \"polarizer\"\naxis = [1.0, 0.0, 0.0]\npass_transmittance = 0.9\nblock_transmittance = 0.0\nblock_reflectance = 0.9\n";
+        let fronted = parse(&format!("[s]\n{lines}back = \"absorber\"\n")).unwrap();
+        let e = fronted
+            .build(&ctx, "surfaces.s", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("surfaces.s.back") && e.contains("'polarizer' lets light through"),
+            "{e}"
+        );
+        let backed = parse(&format!(
+            "[s]\nmodel = \"lambert\"\nalbedo = 0.9\nback = {{ {sheet} }}\n"
+        ))
+        .unwrap();
+        let e = backed
+            .build(&ctx, "surfaces.s", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("surfaces.s.back.model") && e.contains("'polarizer' lets light through"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -230,7 +230,10 @@ pub fn check_ray(
         ));
     }
     if !(flux.is_finite() && flux >= 0.0) {
-        return Err((6, format!("must be finite and >= 0, got {flux}")));
+        return Err((
+            6,
+            format!("must be finite and >= 0, got {}", short(f64::from(flux))),
+        ));
     }
     if let Some(w) = nm
         && !(VISIBLE_NM.0..=VISIBLE_NM.1).contains(&(w as f64))

@@ -9,7 +9,7 @@ use crate::optics::dielectric;
 use crate::optics::medium::{Interface, Medium, air};
 use crate::optics::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
-use crate::spec_check::Ctx;
+use crate::spec_check::{Ctx, short};
 use anyhow::Result;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -115,7 +115,7 @@ impl SurfaceSpecOf for GroovesSpec {
         if !(apex > 0.0 && apex < 180.0) {
             return Err(ctx.err(
                 &f("apex_deg"),
-                format!("must be within (0, 180) degrees, got {apex}"),
+                format!("must be within (0, 180) degrees, got {}", short(apex)),
             ));
         }
         let tilt = ctx.finite(&f("tilt_deg"), self.tilt_deg)?;
@@ -124,8 +124,9 @@ impl SurfaceSpecOf for GroovesSpec {
             return Err(ctx.err(
                 &f("tilt_deg"),
                 format!(
-                    "must be within (-{limit}, {limit}) for apex_deg = {apex}, got {tilt}: both facets must lean \
-                     away from the apex (base angles 90 - apex/2 +- tilt within (0, 90) degrees)"
+                    "must be within (-{limit}, {limit}) for apex_deg = {apex}, got {}: both facets must lean \
+                     away from the apex (base angles 90 - apex/2 +- tilt within (0, 90) degrees)",
+                    short(tilt)
                 ),
             ));
         }

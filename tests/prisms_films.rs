@@ -385,11 +385,15 @@ fn bad_groove_and_diffuser_parameters_are_named() {
         ),
         (
             grooves("apex_deg = 180.0\npitch_mm = 0.2\n"),
-            "surfaces.back.apex_deg: must be within (0, 180)",
+            "surfaces.back.apex_deg: must be within [0.01, 180)",
         ),
         (
             grooves("apex_deg = 0.0\npitch_mm = 0.2\n"),
-            "surfaces.back.apex_deg: must be within (0, 180)",
+            "surfaces.back.apex_deg: must be within [0.01, 180)",
+        ),
+        (
+            grooves("apex_deg = 1e-300\npitch_mm = 0.2\n"),
+            "surfaces.back.apex_deg: must be within [0.01, 180) degrees (a narrower groove is a slit thousands of pitches deep), got 1e-300",
         ),
         (
             grooves("apex_deg = 100.0\ntilt_deg = 45.0\npitch_mm = 0.2\n"),

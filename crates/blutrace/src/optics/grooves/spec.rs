@@ -10,6 +10,10 @@ use crate::optics::medium::{Interface, Medium, air};
 use crate::optics::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::{Ctx, short};
+
+/// Narrowest accepted apex angle (degrees): a groove 5730 pitches deep. Below about 1e-15
+/// degrees the slit's depth left a run of 2000 photons taking 18 s instead of 1.4 s.
+pub const MIN_APEX_DEG: f64 = 0.01;
 use anyhow::Result;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -112,10 +116,14 @@ impl SurfaceSpecOf for GroovesSpec {
         let f = |k: &str| format!("{at}.{k}");
         let pitch = ctx.positive(&f("pitch_mm"), self.pitch_mm)?;
         let apex = ctx.finite(&f("apex_deg"), self.apex_deg)?;
-        if !(apex > 0.0 && apex < 180.0) {
+        if !(MIN_APEX_DEG..180.0).contains(&apex) {
             return Err(ctx.err(
                 &f("apex_deg"),
-                format!("must be within (0, 180) degrees, got {}", short(apex)),
+                format!(
+                    "must be within [{MIN_APEX_DEG}, 180) degrees (a narrower groove is a slit \
+                     thousands of pitches deep), got {}",
+                    short(apex)
+                ),
             ));
         }
         let tilt = ctx.finite(&f("tilt_deg"), self.tilt_deg)?;

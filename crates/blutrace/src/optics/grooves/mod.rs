@@ -6,7 +6,7 @@
 //! inside = "pmma"
 //! outside = "air"              # default
 //! relief = "cut"               # V notches into `inside` ("raised": prisms standing out)
-//! apex_deg = 110.0             # angle between the two facets, in (0, 180)
+//! apex_deg = 110.0             # angle between the two facets, in [0.01, 180)
 //! tilt_deg = 10.0              # default 0: see below
 //! pitch_mm = 0.4               # one groove per pitch
 //! origin = [0.0, 0.0, 0.0]     # a point on the lamp edge (sets the grooves' phase)

@@ -29,7 +29,8 @@ pub struct GroovesSpec {
     pub outside: String,
     /// Notches cut into `inside`, or prisms raised out of the face.
     pub relief: Relief,
-    /// Angle between the two facets (deg), in (0, 180).
+    /// Angle between the two facets (deg), in [0.01, 180): a finer V would be a groove
+    /// thousands of pitches deep, whose paths the tracer cannot follow in bounded time.
     pub apex_deg: f64,
     /// Tilt of the V (deg): the facet on the `-axis` side gets base angle
     /// `90 - apex/2 + tilt`, the other `90 - apex/2 - tilt`.

@@ -14,7 +14,7 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 /// Cases committed: the corpus may grow, never shrink unnoticed.
-const MIN_CASES: usize = 135;
+const MIN_CASES: usize = 137;
 
 /// The address-space limit of every run, in KiB (`ulimit -v`): 2 GiB.
 const MEMORY_KIB: u64 = 2 * 1024 * 1024;

@@ -78,6 +78,13 @@ def test_set_of_a_value_toml_cannot_hold_is_a_type_error_naming_the_key(box):
         box.copy().set("trace.seed", object())
 
 
+def test_set_of_an_array_longer_than_its_key_takes_is_an_error(phone):
+    s = phone.copy()
+    with pytest.raises(bt.BlutraceError, match=r"sources\[0\]\.center: has 4 elements"):
+        s.set("sources.0.center", [1.0, 2.0, 3.0, 4.0])
+    assert len(s.get("sources.0.center")) == 3
+
+
 def test_set_takes_numpy_arrays_and_scalars(phone):
     s = phone.copy()
     s.set("sources.0.center", np.array([1.0, 2.0, 3.0]))

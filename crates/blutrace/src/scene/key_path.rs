@@ -107,6 +107,7 @@ impl Scene {
             .clone()
             .try_into()
             .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        super::array_lengths::check(&crate::spec_check::Ctx(path), &doc, &file)?;
         Scene::build(&file, doc, path, &super::meshio::ReadCache::default())
     }
 }

@@ -8,6 +8,7 @@
 //! - moves the scene's centre to the origin, so f32 backends keep their precision far
 //!   from the file's origin (outputs are in detector coordinates, so nothing changes).
 
+mod array_lengths;
 pub mod check_report;
 pub mod config;
 pub mod geometry_file;
@@ -92,6 +93,7 @@ impl Scene {
         // Typed from the text, so a parse error quotes its line.
         let file: SceneFile = toml::from_str(&text).map_err(parse_error)?;
         let source: toml::Value = toml::from_str(&text).map_err(parse_error)?;
+        array_lengths::check(&Ctx(path), &source, &file)?;
         Self::build(&file, source, path, &ReadCache::default())
     }
 

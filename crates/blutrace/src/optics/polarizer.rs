@@ -31,7 +31,7 @@
 use super::medium::Medium;
 use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
 use super::polarization::{
-    Polarization, Stokes, block_direction, polarizer_reflection, polarizer_transmission,
+    Polarization, any_frame, block_direction, polarizer_reflection, polarizer_transmission,
 };
 use super::spectrum::{Range, Spectral, SpectralValue};
 use crate::rng::PhotonRng;
@@ -111,8 +111,7 @@ impl Surface for Polarizer {
         let (tb, rb) = (self.block.0.at(at.light), self.block.1.at(at.light));
         let block = self.block_axis(normal);
         let (d, mirrored) = (at.dir, super::fresnel::reflect(at.dir, normal));
-        let frame =
-            |d: DVec3| block_direction(d, block).unwrap_or_else(|| d.any_orthonormal_vector());
+        let frame = |d: DVec3| block_direction(d, block).unwrap_or_else(|| any_frame(d));
         let s = pol.stokes_in(d, frame(d));
         let (t, r) = (polarizer_transmission(tp, tb), polarizer_reflection(rp, rb));
         let (pt, pr) = (t.power_of(s), r.power_of(s));
@@ -122,7 +121,7 @@ impl Surface for Polarizer {
         let through = rng.uniform() * (pt + pr) < pt;
         let (dir, m) = if through { (d, t) } else { (mirrored, r) };
         at.pol_out.set(Some(Polarization {
-            stokes: Stokes(m.apply(s).0).normalized(),
+            stokes: m.apply(s).normalized(),
             u: frame(dir),
         }));
         let outcome = Outcome::Scattered {

@@ -44,8 +44,7 @@ pub(super) fn file_hash(file: &SceneFile, path: &Path, polarized: bool) -> Resul
     let mut h = Fnv1a::default();
     h.write(&serde_json::to_vec(&physics)?);
     let dir = path.parent().unwrap_or(Path::new("."));
-    let tables = file.surfaces.values().flat_map(|s| s.files());
-    for f in tables.chain(file.sources.iter().flat_map(|s| s.files())) {
+    for f in super::inputs::table_files(file) {
         h.write(&crate::input_file::read_bytes(
             &dir.join(f),
             "measured table",

@@ -29,13 +29,15 @@ pub fn input_files(file: &SceneFile, path: &Path) -> Vec<PathBuf> {
         files.extend(gltf_buffer_files(&geometry));
         files.push(geometry);
     }
-    let named = file.surfaces.values().flat_map(|s| s.files());
-    files.extend(
-        named
-            .chain(file.sources.iter().flat_map(|s| s.files()))
-            .map(|f| dir.join(f)),
-    );
+    files.extend(table_files(file).map(|f| dir.join(f)));
     files
+}
+
+/// The measured tables, spectra and ray files the surfaces and sources of `file` name,
+/// relative to the scene file (the content hash covers their bytes too).
+pub(super) fn table_files(file: &SceneFile) -> impl Iterator<Item = PathBuf> + '_ {
+    let surfaces = file.surfaces.values().flat_map(|s| s.files());
+    surfaces.chain(file.sources.iter().flat_map(|s| s.files()))
 }
 
 /// The files a `.gltf` file's `buffers[].uri` name beside it (none for `.glb`, embedded

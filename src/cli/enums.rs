@@ -3,7 +3,7 @@
 //! types stay free of the command-line parser.
 
 use blutrace::accel::BackendChoice;
-use blutrace::estimator::Estimator;
+use blutrace::estimator::{Estimator, LuminanceEstimator};
 use blutrace::optimize::Method;
 use blutrace::run::TargetMetric;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
@@ -23,6 +23,21 @@ const ESTIMATORS: &[Choice<Estimator>] = &[
          factor (and exp(-a t) through absorbing media); Russian roulette only once its weight \
          is low. Unbiased, lower variance where absorption is strong",
         Estimator::Weighted,
+    ),
+];
+
+const LUMINANCE_ESTIMATORS: &[Choice<LuminanceEstimator>] = &[
+    (
+        "meter",
+        "Peel-off: at every diffuse event, the light it sends towards each view through the \
+         flat specular layers above it, and the cone count for the rest. Unbiased; converges \
+         at ordinary photon counts",
+        LuminanceEstimator::Meter,
+    ),
+    (
+        "cone",
+        "Count the photons that happen to leave within each view's cone (for cross-checks)",
+        LuminanceEstimator::Cone,
     ),
 ];
 
@@ -108,6 +123,11 @@ fn choices<T: Copy + Send + Sync + 'static>(
     })
 }
 
+/// `--luminance-estimator`.
+pub(super) fn luminance_estimator() -> impl TypedValueParser<Value = LuminanceEstimator> {
+    choices(LUMINANCE_ESTIMATORS)
+}
+
 /// `--estimator`.
 pub(super) fn estimator() -> impl TypedValueParser<Value = Estimator> {
     choices(ESTIMATORS)
@@ -143,6 +163,10 @@ mod tests {
             assert_eq!(table.len(), all.len());
         }
         check(ESTIMATORS, &[Estimator::Analog, Estimator::Weighted]);
+        check(
+            LUMINANCE_ESTIMATORS,
+            &[LuminanceEstimator::Meter, LuminanceEstimator::Cone],
+        );
         check(
             BACKENDS,
             &[

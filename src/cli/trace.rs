@@ -5,8 +5,9 @@ use super::enums;
 use super::{default_out, scene_path, word};
 use anyhow::{Result, bail};
 use blutrace::accel::BackendChoice;
-use blutrace::estimator::Estimator;
+use blutrace::estimator::{Estimator, LuminanceEstimator};
 use blutrace::output::atomic::check_dest;
+use blutrace::run::metrics::cone::LuminanceMapSummary;
 use blutrace::run::{self, Progress, RunOptions, Shard, StoppedBy, TargetMetric};
 use blutrace::scene::Scene;
 use blutrace::shard;
@@ -35,6 +36,10 @@ pub(super) struct TraceArgs {
     /// Analog roulette (the paper's) or absorption by weights.
     #[arg(long, value_parser = enums::estimator(), default_value = "analog")]
     estimator: Estimator,
+    /// How the luminance maps are estimated: the meter's peel-off (default) or the cone
+    /// count.
+    #[arg(long, value_parser = enums::luminance_estimator(), default_value = "meter")]
+    luminance_estimator: LuminanceEstimator,
     /// Seed of the per-photon random streams (default: the scene's [trace] seed).
     #[arg(long)]
     seed: Option<u64>,
@@ -107,6 +112,7 @@ pub(super) fn trace(args: TraceArgs, quiet: bool) -> Result<ExitCode> {
         threads: args.threads,
         backend: args.backend,
         estimator: args.estimator,
+        luminance_estimator: args.luminance_estimator,
         target_error: args.target_error,
         target_metric: args.target_metric,
         max_time_s: args.max_time,
@@ -341,32 +347,9 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         );
     }
     if let Some(m) = &s.luminance_map {
-        let num = |x: f64, digits: usize| err(x, digits, false);
-        say!(
-            "luminance  map within {}° of the normal: mean {} ± {} cd/m², 13-point min/max {} ± {}, cv {} (noise floor {})",
-            m.cone_deg,
-            num(m.mean_cd_m2.value, 1),
-            err(m.mean_cd_m2.stderr, 1, false),
-            num(m.thirteen_point_min_over_max.value, 3),
-            err(m.thirteen_point_min_over_max.stderr, 3, false),
-            num(m.cv.value, 3),
-            num(m.cv_noise_floor, 3)
-        );
-        let needed = match m.photons_needed.is_finite() {
-            true => format!("about {:.1e} photons", m.photons_needed),
-            false => "more photons".to_string(),
-        };
-        if m.photons_in_cone == 0 {
-            say!(
-                "note       no photon left the target within the {}° cone in {} photons: the luminance map measured nothing (null in summary.json, not 0 cd/m²); a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
-                m.cone_deg,
-                s.photons
-            );
-        } else if m.cv_noise_floor > 0.3 {
-            say!(
-                "note       the luminance map is mostly noise at this photon count (a {}° cone holds few photons): a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
-                m.cone_deg
-            );
+        print_luminance_map(m, s.luminance_estimator, s.photons);
+        for v in s.luminance_views.iter().skip(1) {
+            print_luminance_map(v, s.luminance_estimator, s.photons);
         }
     }
     if let Some(c) = &s.color {
@@ -466,4 +449,55 @@ pub(super) fn merge(args: MergeArgs) -> Result<ExitCode> {
     let files = result.write(&args.out)?;
     print_report(&result.summary(), &files);
     Ok(ExitCode::SUCCESS)
+}
+
+/// The luminance map of one view: its numbers, and a note when it is mostly noise or
+/// the meter's peel-off could not reach most of its light.
+fn print_luminance_map(m: &LuminanceMapSummary, estimator: LuminanceEstimator, photons: u64) {
+    let num = |x: f64, digits: usize| err(x, digits, false);
+    let view = match m.view_deg {
+        [0.0, _] => "the normal".to_string(),
+        [theta, phi] => format!("theta {theta}° phi {phi}°"),
+    };
+    let how = match estimator {
+        LuminanceEstimator::Cone => "cone count".to_string(),
+        LuminanceEstimator::Meter if m.cone_counted_fraction.is_finite() => format!(
+            "meter, {:.1}% by peel-off",
+            100.0 * (1.0 - m.cone_counted_fraction)
+        ),
+        LuminanceEstimator::Meter => "meter".to_string(),
+    };
+    say!(
+        "luminance  map within {}° of {view} ({how}): mean {} ± {} cd/m², 13-point min/max {} ± {}, cv {} (noise floor {})",
+        m.cone_deg,
+        num(m.mean_cd_m2.value, 1),
+        err(m.mean_cd_m2.stderr, 1, false),
+        num(m.thirteen_point_min_over_max.value, 3),
+        err(m.thirteen_point_min_over_max.stderr, 3, false),
+        num(m.cv.value, 3),
+        num(m.cv_noise_floor, 3)
+    );
+    let needed = match m.photons_needed.is_finite() {
+        true => format!("about {:.1e} photons", m.photons_needed),
+        false => "more photons".to_string(),
+    };
+    if m.photons_in_cone == 0 {
+        say!(
+            "note       no photon reached the luminance meter ({}° cone) in {photons} photons: the luminance map measured nothing (null in summary.json, not 0 cd/m²); a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
+            m.cone_deg,
+        );
+        return;
+    }
+    if estimator == LuminanceEstimator::Meter && m.cone_counted_fraction > 0.5 {
+        let cause = m.cone_counted_mostly.as_deref().unwrap_or("?");
+        say!(
+            "note       the meter's peel-off reached only {:.0}% of this light: {cause} kept it from the rest, which is counted in the cone",
+            100.0 * (1.0 - m.cone_counted_fraction)
+        );
+    }
+    if m.cv_noise_floor > 0.3 {
+        say!(
+            "note       the luminance map is mostly noise at this photon count: a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg"
+        );
+    }
 }

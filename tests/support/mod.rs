@@ -349,3 +349,11 @@ pub fn dot_pattern(lattice: Lattice, density: Density, length: f64) -> DotPatter
         placement_seed: 0,
     }
 }
+
+/// The `scene.toml` of the bundled scene `name`.
+pub fn repo_scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .join("scene.toml")
+}

@@ -8,7 +8,8 @@
 //! size_mm = [300.0, 200.0]
 //! bins = [100, 100]
 //! angular_bins = [18, 36]    # theta over [0, 90] deg from the normal, phi over [0, 360)
-//! luminance_cone_deg = 2.0   # half-angle about the normal of the luminance map's cone
+//! luminance_cone_deg = 2.0   # half-angle of the luminance map's cone about each view
+//! views = [[0.0, 0.0], [45.0, 0.0]]  # [theta_deg, phi_deg] of each luminance map; default the normal
 //! ```
 //!
 //! The luminance map (cd/m², with lumens or spectra) counts the light leaving each bin
@@ -58,6 +59,14 @@ pub struct DetectorSpec {
     /// Half-angle (degrees) of the luminance map's cone about the normal.
     #[serde(default = "default_luminance_cone_deg")]
     pub luminance_cone_deg: f64,
+    /// The directions a luminance meter looks from, `[theta_deg, phi_deg]` (theta from
+    /// the normal, phi from u towards v): one luminance map each. Default: the normal.
+    #[serde(default = "default_views")]
+    pub views: Vec<[f64; 2]>,
+}
+
+fn default_views() -> Vec<[f64; 2]> {
+    vec![[0.0, 0.0]]
 }
 
 fn default_luminance_cone_deg() -> f64 {
@@ -96,9 +105,11 @@ impl DetectorSpec {
         }
         let cone = d.luminance_cone_deg;
         check_cone(cone).map_err(|e| ctx.err("detector.luminance_cone_deg", e))?;
+        check_views(&d.views, cone).map_err(|e| ctx.err("detector.views", e))?;
         Ok(TargetPlane {
             luminance_cone_deg: cone,
             cone_cos: cone.to_radians().cos(),
+            views: d.views.clone(),
             origin: ctx.point("detector.origin", d.origin)?,
             u,
             v,
@@ -128,6 +139,41 @@ fn check_cone(deg: f64) -> Result<(), String> {
     }
 }
 
+/// Most luminance views a detector may have (each is a map, and a trace per scattering
+/// event under the meter estimator).
+pub const MAX_VIEWS: usize = 64;
+
+/// Views must be 1..=[`MAX_VIEWS`] of finite angles whose cone stays above the plane:
+/// `theta + cone <= 89` degrees (a cone reaching the plane would count light crossing it
+/// sideways).
+fn check_views(views: &[[f64; 2]], cone: f64) -> Result<(), String> {
+    if views.is_empty() || views.len() > MAX_VIEWS {
+        return Err(format!(
+            "must list 1 to {MAX_VIEWS} [theta_deg, phi_deg] pairs, got {}",
+            views.len()
+        ));
+    }
+    for (i, [theta, phi]) in views.iter().enumerate() {
+        let short = crate::spec_check::short;
+        if !(theta.is_finite() && phi.is_finite()) {
+            return Err(format!(
+                "[{i}] must be finite angles, got [{}, {}]",
+                short(*theta),
+                short(*phi)
+            ));
+        }
+        if !(0.0..=89.0 - cone).contains(theta) {
+            return Err(format!(
+                "[{i}]: theta_deg must be within [0, {}] (89 degrees less the luminance cone's {} degrees), got {}",
+                short(89.0 - cone),
+                short(cone),
+                short(*theta)
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The target plane and its binning.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TargetPlane {
@@ -147,6 +193,8 @@ pub struct TargetPlane {
     pub luminance_cone_deg: f64,
     /// Its cosine.
     pub cone_cos: f64,
+    /// The luminance maps' views, `[theta_deg, phi_deg]` ([`DetectorSpec::views`]).
+    pub views: Vec<[f64; 2]>,
 }
 
 impl TargetPlane {
@@ -158,20 +206,41 @@ impl TargetPlane {
     /// Set the luminance cone's half-angle to `deg` degrees, or say why not.
     pub fn set_luminance_cone(&mut self, deg: f64) -> Result<(), String> {
         check_cone(deg)?;
+        check_views(&self.views, deg)?;
         self.luminance_cone_deg = deg;
         self.cone_cos = deg.to_radians().cos();
         Ok(())
     }
 
-    /// Whether a detected direction lies within the luminance cone.
-    #[inline]
-    pub fn in_cone(&self, dir: DVec3) -> bool {
-        dir.dot(self.normal()) >= self.cone_cos
+    /// The unit direction of view `k` (towards the viewer).
+    pub fn view_dir(&self, k: usize) -> DVec3 {
+        let [theta, phi] = self.views[k].map(f64::to_radians);
+        let tangent = self.u * phi.cos() + self.v * phi.sin();
+        (self.normal() * theta.cos() + tangent * theta.sin()).normalize()
     }
 
-    /// Projected solid angle of the luminance cone, `pi sin^2(half-angle)` (sr).
-    pub fn cone_projected_solid_angle(&self) -> f64 {
-        std::f64::consts::PI * self.luminance_cone_deg.to_radians().sin().powi(2)
+    /// The views (their indices, as a bit set) whose luminance cone holds `dir`.
+    #[inline]
+    pub fn cones_holding(&self, dir: DVec3) -> u64 {
+        (0..self.views.len())
+            .filter(|&k| dir.dot(self.view_dir(k)) >= self.cone_cos)
+            .fold(0, |set, k| set | 1 << k)
+    }
+
+    /// Projected solid angle of view `k`'s luminance cone on the target plane,
+    /// `cos(theta) pi sin^2(half-angle)` (sr): the integral of the direction's cosine
+    /// with the normal over the cone, which is the cone's axis cosine times the integral
+    /// of its cosine with the axis.
+    pub fn cone_projected_solid_angle(&self, k: usize) -> f64 {
+        let axis_cos = self.views[k][0].to_radians().cos();
+        axis_cos * std::f64::consts::PI * self.luminance_cone_deg.to_radians().sin().powi(2)
+    }
+
+    /// Solid angle of the luminance cone, `2 pi (1 - cos c)` (sr), from the cone's
+    /// margin `1 - cos c` computed without cancellation.
+    pub fn cone_solid_angle(&self) -> f64 {
+        let half = self.luminance_cone_deg.to_radians() / 2.0;
+        TAU * 2.0 * half.sin().powi(2)
     }
 
     /// Size of one flux bin along u and v (mm).
@@ -335,6 +404,7 @@ mod tests {
             angular_bins: [9, 12],
             luminance_cone_deg: 2.0,
             cone_cos: 2.0f64.to_radians().cos(),
+            views: vec![[0.0, 0.0], [30.0, 90.0]],
         }
     }
 
@@ -349,6 +419,41 @@ mod tests {
         assert!(p.intersect(&down, 10.0).is_none());
         let outside = Ray::new(DVec3::new(12.0, 1.5, -1.0), DVec3::Z);
         assert!(p.intersect(&outside, 10.0).is_none());
+    }
+
+    #[test]
+    fn views_point_from_theta_and_phi() {
+        let p = plane();
+        assert!((p.view_dir(0) - DVec3::Z).length() < 1e-15);
+        let oblique = p.view_dir(1);
+        let want = DVec3::new(0.0, 0.5, 3f64.sqrt() / 2.0);
+        assert!((oblique - want).length() < 1e-15, "{oblique}");
+        assert_eq!(p.cones_holding(DVec3::Z), 1);
+        assert_eq!(p.cones_holding(want), 2);
+        assert_eq!(p.cones_holding(DVec3::X), 0);
+    }
+
+    #[test]
+    fn cone_projected_solid_angle_integrates_the_cosine() {
+        // Midpoint rule over the oblique view's cone, in polar coordinates about its axis.
+        let p = plane();
+        let axis = p.view_dir(1);
+        let (t, b) = crate::geometry::orthonormal_basis(axis);
+        let c = p.luminance_cone_deg.to_radians();
+        let (na, nb) = (400, 400);
+        let mut sum = 0.0;
+        for i in 0..na {
+            let a = c * (i as f64 + 0.5) / na as f64;
+            for j in 0..nb {
+                let phi = TAU * (j as f64 + 0.5) / nb as f64;
+                let d = axis * a.cos() + (t * phi.cos() + b * phi.sin()) * a.sin();
+                sum += d.dot(p.normal()) * a.sin() * (c / na as f64) * (TAU / nb as f64);
+            }
+        }
+        let want = p.cone_projected_solid_angle(1);
+        assert!((sum - want).abs() < 1e-6 * want, "{sum} vs {want}");
+        let solid = 2.0 * std::f64::consts::PI * (1.0 - c.cos());
+        assert!((p.cone_solid_angle() - solid).abs() < 1e-12 * solid);
     }
 
     #[test]

@@ -28,3 +28,26 @@ impl Estimator {
         }
     }
 }
+
+/// How the luminance maps are estimated (`blutrace trace --luminance-estimator`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LuminanceEstimator {
+    /// The luminance meter's estimator: at every diffuse event, the light that leaves
+    /// towards each view through the specular layers above it (peel-off, the tracer's
+    /// `meter`), and the cone count for the light no peel-off reaches. Unbiased.
+    #[default]
+    Meter,
+    /// Count the photons that happen to leave within each view's cone.
+    Cone,
+}
+
+impl LuminanceEstimator {
+    /// Its name on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            LuminanceEstimator::Meter => "meter",
+            LuminanceEstimator::Cone => "cone",
+        }
+    }
+}

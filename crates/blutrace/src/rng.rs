@@ -20,6 +20,8 @@ use rand_pcg::Pcg64;
 
 /// PCG's default increment: one fixed stream, hashed starting points on it.
 const STREAM: u128 = 0x0a02_bdbf_7bb3_c0a7_ac28_fa16_a64a_bf96;
+/// The side stream's increment (odd, as PCG needs; another stream of the same states).
+const SIDE_STREAM: u128 = 0x5851_f42d_4c95_7f2d_1405_7b7e_f767_814f;
 /// Odd constant that separates the two 64-bit halves of a photon's starting state.
 const HALF_KEY: u64 = 0xD1B5_4A32_D192_ED03;
 
@@ -30,6 +32,13 @@ impl PhotonRng {
     /// The stream of photon `index` in a run seeded with `seed`.
     pub fn new(seed: u64, index: u64) -> Self {
         Self(Pcg64::new(start_state(seed, index), STREAM))
+    }
+
+    /// A second stream of photon `index`, independent of [`PhotonRng::new`]'s (another
+    /// PCG stream increment): the luminance meter's peel-off draws from it, so the
+    /// photon's own path is the same whichever luminance estimator runs.
+    pub fn side_stream(seed: u64, index: u64) -> Self {
+        Self(Pcg64::new(start_state(seed, index), SIDE_STREAM))
     }
 
     /// A uniform number in `[0, 1)` with 53 random bits.

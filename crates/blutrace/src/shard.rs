@@ -12,6 +12,7 @@
 //! hash), seed, photon count, shard count and estimator; missing shards are an error unless
 //! `--partial` is given, which merges what is there and says what is missing.
 
+use crate::estimator::LuminanceEstimator;
 use crate::optics::surface::Estimator;
 use crate::output::atomic::OutputSet;
 use crate::run::metrics::ScoredBins;
@@ -54,6 +55,9 @@ pub struct ShardFile {
     pub range: [u64; 2],
     /// Estimator used.
     pub estimator: Estimator,
+    /// How the luminance maps were estimated (absent in older shards: the cone).
+    #[serde(default = "cone")]
+    pub luminance_estimator: LuminanceEstimator,
     /// Backend used.
     pub backend: String,
     /// Tracing seconds.
@@ -85,6 +89,7 @@ impl ShardFile {
             shard,
             range: [first, last],
             estimator: o.estimator,
+            luminance_estimator: o.luminance_estimator,
             backend: result.backend.to_string(),
             runtime_s: result.runtime_s,
             threads: result.threads,
@@ -213,6 +218,11 @@ pub fn check(shards: &[(PathBuf, ShardFile)], scene: &Scene) -> Result<Vec<u64>>
             format!("{:?}", s.estimator),
             format!("{:?}", first.estimator),
         )?;
+        same(
+            "luminance estimator",
+            s.luminance_estimator.name().into(),
+            first.luminance_estimator.name().into(),
+        )?;
         if s.scene_hash != hash {
             bail!(
                 "{}: traced a scene with hash {}, but {} now hashes to {hash}: the scene changed",
@@ -299,6 +309,7 @@ pub fn merge(shards: &[(PathBuf, ShardFile)], scene: impl SharedScene) -> Result
             photons: first.photons,
             seed: first.seed,
             estimator: first.estimator,
+            luminance_estimator: first.luminance_estimator,
             ..RunOptions::default()
         },
         // The threads of one shard (the most any used): each shard is its own process, so
@@ -338,4 +349,9 @@ fn backend_name(names: &[&str]) -> &'static str {
         .into_iter()
         .find(|n| all(n))
         .unwrap_or("mixed")
+}
+
+/// The luminance estimator of a shard written before there was a choice.
+fn cone() -> LuminanceEstimator {
+    LuminanceEstimator::Cone
 }

@@ -9,11 +9,13 @@
 //! totals, and 1e10 photons accumulate without drift. They are read out as f64.
 
 pub mod color;
+pub mod meter;
 
 use crate::optics::spectrum::Light;
 use crate::optics::surface::MediumId;
 use crate::scene::Scene;
 pub use color::{ColorTally, ScoredXyz};
+pub use meter::{MeterHit, MeterTally};
 use serde::{Deserialize, Serialize};
 
 const FRACTION_BITS: i32 = 64;
@@ -484,10 +486,10 @@ pub struct Tally {
     /// X, Y, Z of the detected light, when the sources have spectra ([`color`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub color: Option<ColorTally>,
-    /// Per flux bin, the light detected within the luminance cone (spectral: ȳ-weighted,
-    /// as the Y tally; else radiant weight), when the sources give lumens or spectra.
+    /// Per view and flux bin, the light the luminance meter reads (spectral: X, Y, Z;
+    /// else radiant weight), when the sources give lumens or spectra ([`meter`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cone: Option<Grid>,
+    pub meter: Option<MeterTally>,
     /// Per flux bin, the detected light's weight times `S1/S0`, `S2/S0`, `S3/S0` in the
     /// detector's frame (sums of either sign), when polarization is traced.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -505,8 +507,11 @@ impl Tally {
                 .sources
                 .spectral()
                 .then(|| ColorTally::new(&flux, &angular)),
-            cone: (scene.sources.spectral() || scene.sources.luminous_efficacy().is_some())
-                .then(|| Grid::new(flux.nx, flux.ny)),
+            meter: scene.luminous().then(|| {
+                let spectral = scene.sources.spectral();
+                let places = scene.tags.len() + scene.sources.list.len();
+                MeterTally::new(d.views.len(), (flux.nx, flux.ny), spectral, places)
+            }),
             stokes: scene
                 .polarized
                 .then(|| [0, 1, 2].map(|_| Grid::new(d.bins[0], d.bins[1]))),
@@ -545,7 +550,7 @@ impl Tally {
             ]
             .into_iter()
             .chain(t.color.iter().flat_map(ColorTally::shape))
-            .chain(t.cone.iter().map(|g| (g.nx, g.ny, g.bins.len())))
+            .chain(t.meter.iter().flat_map(MeterTally::shape))
             .chain(
                 t.stokes
                     .iter()
@@ -600,7 +605,7 @@ impl Tally {
         } else if bad_bin(&self.flux)
             || bad_bin(&self.angular)
             || self.color.as_ref().is_some_and(|c| c.has_bad_bin(photons))
-            || self.cone.as_ref().is_some_and(bad_bin)
+            || self.meter.as_ref().is_some_and(|m| m.has_bad_bin(photons))
         {
             "a bin holds negative weight, or more photons than were emitted".into()
         } else {
@@ -621,7 +626,7 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
             a.checked_merge(b)?;
         }
-        if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
+        if let (Some(a), Some(b)) = (&mut self.meter, &o.meter) {
             a.checked_merge(b)?;
         }
         if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
@@ -639,7 +644,7 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.color, &o.color) {
             a.merge_signed(b, sign);
         }
-        if let (Some(a), Some(b)) = (&mut self.cone, &o.cone) {
+        if let (Some(a), Some(b)) = (&mut self.meter, &o.meter) {
             a.merge_signed(b, sign);
         }
         if let (Some(a), Some(b)) = (&mut self.stokes, &o.stokes) {
@@ -675,12 +680,8 @@ impl Tally {
         if let Some(color) = &mut self.color {
             color.absorb(&c.detections, xyz);
         }
-        if let Some(cone) = &mut self.cone {
-            for (i, d) in c.detections.iter().enumerate().filter(|(_, d)| d.in_cone) {
-                // The luminous weight: Y in a spectral run, else the radiant weight.
-                let one = xyz.get(i).map_or(&scored[i], |x| &x[1]);
-                cone.bins[d.flux_bin as usize].merge(one);
-            }
+        if let Some(meter) = &mut self.meter {
+            meter.absorb(&c.meter, c.peeled, &c.counted);
         }
         if let Some(stokes) = &mut self.stokes {
             for (d, s) in c.detections.iter().zip(&c.stokes) {
@@ -714,8 +715,6 @@ pub struct Detection {
     pub weight: f64,
     /// The photon's light (its wavelength, for the colour tallies).
     pub light: Light,
-    /// Whether it left within the detector's luminance cone.
-    pub in_cone: bool,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between
@@ -729,6 +728,17 @@ pub struct ChunkTally {
     /// Each detection's `(S1, S2, S3) / S0` in the detector's frame, when polarization is
     /// traced (else empty: kept apart so that a run without it moves no more bytes).
     pub stokes: Vec<[f64; 3]>,
+    /// What the luminance meter read, per photon merged per view and bin (empty without
+    /// a luminance map).
+    pub meter: Vec<MeterHit>,
+    /// Per place a peel-off starts from (each tag, then each lamp body), the peel-offs
+    /// tried in this chunk and those that reached the target (the tracer's `meter`).
+    pub peel_tries: Vec<[u32; 2]>,
+    /// Radiant weight the meter's peel-off scored, and what it counted in the cones by
+    /// cause ([`MeterTally::counted`]).
+    pub peeled: ExactSum,
+    /// See `peeled`.
+    pub counted: Vec<ExactSum>,
     /// The chunk's ledger.
     pub ledger: Ledger,
 }

@@ -19,11 +19,13 @@
 
 mod body_boxes;
 mod flight;
+mod meter;
 mod solid_walk;
 mod tir_run;
 
 use crate::accel::Accel;
 use crate::accel::convex::ConvexSolid;
+use crate::estimator::LuminanceEstimator;
 use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::absorber::Absorber;
 use crate::optics::model::Arrival;
@@ -34,7 +36,8 @@ use crate::optics::two_sided;
 use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::sources::body::LampBody;
-use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger};
+use crate::tally::meter::Cause;
+use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger, MeterHit};
 use body_boxes::BodyBoxes;
 use flight::Flight;
 use solid_walk::Walks;
@@ -71,6 +74,8 @@ pub struct Tracer<'a> {
     walks: Walks<'a>,
     /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
     bodies: BodyBoxes,
+    /// How the luminance maps are estimated ([`meter`]); `None`: the scene has none.
+    luminance: Option<LuminanceEstimator>,
 }
 
 /// A photon in flight.
@@ -86,6 +91,18 @@ struct Photon {
     /// Analog estimator: the optical depth of clear-medium absorption the photon has
     /// left (an Exp(1) draw, made on its first absorbing segment; negative until then).
     absorption_depth: f64,
+    /// Whether the luminance meter's peel-off at its last diffuse event scored its light
+    /// ([`meter`]): then its crossing of the target is not counted in the cone again.
+    covered: bool,
+    /// The `n t` it left its last diffuse event with ([`meter`]).
+    left_with: glam::DVec3,
+    /// Why no peel-off covers its light ([`crate::tally::meter::MeterTally::counted`]'s
+    /// index), when `covered` is false.
+    cause: u32,
+    /// The last place since its diffuse event that turned its `n t` (`u32::MAX`: none).
+    turned: u32,
+    /// The stream its peel-offs draw from, under the meter estimator.
+    peel_rng: Option<PhotonRng>,
 }
 
 impl Photon {
@@ -117,7 +134,17 @@ impl<'a> Tracer<'a> {
             facets,
             walks: Walks::new(scene, convex, &bodies),
             bodies,
+            luminance: scene.luminous().then_some(LuminanceEstimator::Cone),
         }
+    }
+
+    /// Estimate the luminance maps with `e` (a tracer as built counts the cone), when the
+    /// scene has them.
+    pub fn luminance_estimator(mut self, e: LuminanceEstimator) -> Self {
+        if self.luminance.is_some() {
+            self.luminance = Some(e);
+        }
+        self
     }
 
     /// Follow photon `index` of the run seeded `seed` to its fate, scoring into `out`.
@@ -134,11 +161,19 @@ impl<'a> Tracer<'a> {
                 .polarized
                 .then(|| emitted_polarization(self.scene, &e)),
             absorption_depth: -1.0,
+            covered: false,
+            left_with: glam::DVec3::ZERO,
+            cause: Cause::Emission.index(self.places()),
+            turned: u32::MAX,
+            peel_rng: (self.luminance == Some(LuminanceEstimator::Meter))
+                .then(|| PhotonRng::side_stream(seed, index)),
         };
         out.ledger.photons += 1;
         out.ledger.emitted.add(1.0);
+        let from = out.meter.len();
         let fate = self.follow(&mut p, &mut rng, out);
         out.ledger.end(fate, p.weight, e.source);
+        crate::tally::meter::merge_photon_hits(&mut out.meter, from);
     }
 
     /// The photon loop: nearest event, the medium on the way, surface roulette, repeat;
@@ -163,6 +198,8 @@ impl<'a> Tracer<'a> {
                 Flight::Absorbed => return Fate::AbsorbedInMedium(p.medium),
                 Flight::Scattered { .. } => {
                     out.ledger.interactions += 1;
+                    p.covered = false;
+                    p.cause = Cause::Volume.index(self.places());
                     if !roulette(p, rng, &mut out.ledger) {
                         return Fate::Roulette;
                     }
@@ -177,6 +214,7 @@ impl<'a> Tracer<'a> {
                 if let Some(pol) = &p.pol {
                     out.stokes.push(scene.detector.stokes_of(pol, true_ray.dir));
                 }
+                self.count_in_cones(p, (ab, true_ray.dir), weight, out);
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
@@ -194,8 +232,19 @@ impl<'a> Tracer<'a> {
                 pol: p.pol,
                 pol_out: &pol_out,
             };
+            let before = p.weight;
             let (outcome, feature) = model.interact_on(&at, rng);
             struck.count(&mut out.ledger, feature);
+            if self.luminance == Some(LuminanceEstimator::Meter) {
+                let v = meter::Vertex {
+                    at: &at,
+                    model,
+                    feature,
+                    weight: before,
+                    start: struck.start(self.scene),
+                };
+                self.meter_event(p, &v, &outcome, out);
+            }
             match outcome {
                 Outcome::Absorbed => return struck.absorbed(),
                 Outcome::Scattered {
@@ -217,6 +266,45 @@ impl<'a> Tracer<'a> {
             }
         }
         Fate::Killed
+    }
+
+    /// Count the photon `p` crossing the target at `ab` along `dir` with detected weight
+    /// `weight` in the luminance cones holding `dir`: every one under the cone estimator,
+    /// and under the meter's only when no peel-off scored its light.
+    fn count_in_cones(
+        &self,
+        p: &Photon,
+        (ab, dir): ([f64; 2], glam::DVec3),
+        weight: f64,
+        out: &mut ChunkTally,
+    ) {
+        let Some(mode) = self.luminance else {
+            return;
+        };
+        if mode == LuminanceEstimator::Meter && self.peeled(p, dir) {
+            return;
+        }
+        let d = &self.scene.detector;
+        let cones = d.cones_holding(dir);
+        for k in (0..d.views.len()).filter(|k| cones >> k & 1 == 1) {
+            out.meter.push(MeterHit {
+                view: k as u16,
+                flux_bin: d.flux_index(ab) as u32,
+                weight,
+                light: p.light,
+            });
+            let cause = match (p.covered, p.turned) {
+                (false, _) => p.cause,
+                (true, u32::MAX) => Cause::TurnedInWalk.index(self.places()),
+                (true, turned) => turned,
+            };
+            out.counted[cause as usize].add(weight);
+        }
+    }
+
+    /// The places a peel-off may start from: every tag, then every lamp body.
+    fn places(&self) -> usize {
+        self.scene.tags.len() + self.scene.sources.list.len()
     }
 
     /// The surface or lamp body `p` reaches first along `true_ray` (its path from its
@@ -358,6 +446,10 @@ impl<'a> Tracer<'a> {
             index,
             detections: Vec::new(),
             stokes: Vec::new(),
+            meter: Vec::new(),
+            peel_tries: vec![[0; 2]; self.places()],
+            peeled: ExactSum::default(),
+            counted: vec![ExactSum::default(); self.places() + Cause::ALL.len()],
             ledger: Ledger::new(
                 self.scene.tags.len(),
                 self.scene.media.len(),
@@ -401,6 +493,14 @@ impl Struck {
         match self {
             Struck::Surface(tag) => ledger.hit(tag, feature != Feature::Plain),
             Struck::Body(_) | Struck::BodyBack(_) => ledger.interactions += 1,
+        }
+    }
+
+    /// Where a peel-off from it starts, as [`ChunkTally::peel_tries`] counts them.
+    fn start(self, scene: &Scene) -> usize {
+        match self {
+            Struck::Surface(tag) => tag as usize,
+            Struck::Body(i) | Struck::BodyBack(i) => scene.tags.len() + i as usize,
         }
     }
 
@@ -507,7 +607,6 @@ fn detection(
         angular_bin: d.angular_index(dir) as u32,
         weight,
         light,
-        in_cone: d.in_cone(dir),
     }
 }
 
@@ -558,6 +657,7 @@ fn assert_same_chunks_of(
             assert_eq!(a.ledger, b.ledger, "{what}");
             assert_eq!(a.detections, b.detections, "{what}");
             assert_eq!(a.stokes, b.stokes, "{what}");
+            assert_eq!(a.meter, b.meter, "{what}");
             a
         })
         .into()

@@ -9,7 +9,7 @@
 //! ```
 
 use super::medium::{Interface, Medium, MediumId, air};
-use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -45,6 +45,10 @@ impl Surface for Interface {
 
     fn interface(&self) -> Option<Interface> {
         Some(*self)
+    }
+
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Specular
     }
 }
 

@@ -52,7 +52,7 @@ use super::density::graded_x_max;
 pub use super::density::{Density, DensityGrid, DensityKeys, Gradation, XUnit};
 use super::density::{check_pitch, check_span};
 use super::medium::{Interface, Medium, air};
-use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 pub use super::placement::Placement;
 use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{dielectric, lambert};
@@ -153,6 +153,17 @@ impl Surface for Dots {
 
     fn interface(&self) -> Option<Interface> {
         Some(self.interface)
+    }
+
+    fn meter_vertex(&self, feature: Feature) -> MeterVertex {
+        match feature {
+            Feature::Ink => MeterVertex::Diffuse,
+            _ => MeterVertex::Specular,
+        }
+    }
+
+    fn meter_density(&self, at: &Arrival, _feature: Feature, out: DVec3) -> f64 {
+        self.ink_albedo.at(at.light) * lambert::density(at.facing(), out)
     }
 
     fn translate(&mut self, by: DVec3) {

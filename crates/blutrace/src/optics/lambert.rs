@@ -9,7 +9,7 @@
 //! The ink of [`super::dots`] and the diffuse part of [`super::phong`] reflect the same way.
 
 use super::medium::Medium;
-use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::sampling;
 use super::spectrum::{Range, Spectral, SpectralValue};
 use crate::rng::PhotonRng;
@@ -52,6 +52,21 @@ impl Surface for Lambert {
             Feature::Plain,
         )
     }
+
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Diffuse
+    }
+
+    fn meter_density(&self, at: &Arrival, _feature: Feature, out: DVec3) -> f64 {
+        self.albedo.at(at.light) * density(at.facing(), out)
+    }
+}
+
+/// The Lambertian density (per sr) of leaving along unit `out` about the unit normal
+/// `facing`: `cos / pi` on its side, 0 behind it.
+#[inline]
+pub fn density(facing: DVec3, out: DVec3) -> f64 {
+    out.dot(facing).max(0.0) * std::f64::consts::FRAC_1_PI
 }
 
 /// A Lambertian direction back into the side the photon of `at` came from.

@@ -7,7 +7,7 @@
 //! ```
 
 use super::medium::Medium;
-use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
@@ -57,6 +57,10 @@ impl Surface for Mirror {
         let mirrored = at.pol.map(|p| polarization::mirrored(&p, at.dir, facing));
         at.pol_out.set(mirrored);
         (out, Feature::Plain)
+    }
+
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Specular
     }
 }
 

@@ -42,6 +42,20 @@ pub trait Surface {
         None
     }
 
+    /// What an event of this model that met `feature` is to the luminance meter's
+    /// estimator ([`MeterVertex`]). By default [`MeterVertex::Unevaluated`]: the meter
+    /// counts the light such an event sends out as the cone does.
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Unevaluated
+    }
+
+    /// For a [`MeterVertex::Diffuse`] event of the photon `at` that met `feature`: the
+    /// probability density (per steradian, the albedo included) that the light leaves
+    /// along unit `out`, the density [`Surface::interact`] samples from.
+    fn meter_density(&self, _at: &Arrival, _feature: Feature, _out: DVec3) -> f64 {
+        0.0
+    }
+
     /// Move the model's anchor points (a pattern's origin) with the scene by `by` (mm).
     fn translate(&mut self, _by: DVec3) {}
 
@@ -170,6 +184,21 @@ pub enum Outcome {
     },
     /// The photon was absorbed by this surface.
     Absorbed,
+}
+
+/// What an event is to the luminance meter's estimator (the tracer's `meter`): its
+/// peel-off evaluates, at every diffuse event, the light that leaves towards the meter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeterVertex {
+    /// A specular event (a smooth interface, a mirror, a polarizer, a groove facet): its
+    /// direction follows from the one it met, so the peel-off path goes through it.
+    Specular,
+    /// A diffuse event whose density the model evaluates ([`Surface::meter_density`]):
+    /// the peel-off starts there.
+    Diffuse,
+    /// A scattering event whose density the model does not evaluate (a multiple-scattering
+    /// rough face, a measured table): the light it sends out is counted in the cone.
+    Unevaluated,
 }
 
 /// What part of a patterned face a hit met (see `SurfaceModel::interact_on`).

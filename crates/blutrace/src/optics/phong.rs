@@ -12,7 +12,7 @@
 //! into a `cos^exponent` lobe about the mirror direction and the rest is Lambertian.
 
 use super::medium::Medium;
-use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{fresnel, lambert, sampling};
 use crate::rng::PhotonRng;
@@ -68,9 +68,30 @@ impl Surface for Phong {
         });
         (out, Feature::Plain)
     }
+
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Diffuse
+    }
+
+    fn meter_density(&self, at: &Arrival, _feature: Feature, out: DVec3) -> f64 {
+        self.reflectance.at(at.light) * self.density(at.facing(), at.dir, out)
+    }
 }
 
 impl Phong {
+    /// The density (per sr) of [`Phong::direction`] leaving along unit `out`: the
+    /// Lambertian part's `cos / pi` and the lobe's `(m + 1) / (2 pi) cos^m` about the
+    /// mirror direction ([`sampling::cos_power`]'s), both zero below the surface.
+    pub fn density(&self, facing: DVec3, dir: DVec3, out: DVec3) -> f64 {
+        if out.dot(facing) <= 0.0 {
+            return 0.0;
+        }
+        let mirror = fresnel::reflect(dir, facing);
+        let m = self.exponent;
+        let lobe = (m + 1.0) / std::f64::consts::TAU * out.dot(mirror).max(0.0).powf(m);
+        (1.0 - self.specular) * lambert::density(facing, out) + self.specular * lobe
+    }
+
     /// A reflected direction from the Phong BRDF, given that the photon arriving along
     /// `dir` is reflected (`facing`: the unit normal on its side): diffuse with
     /// probability `1 - specular`, else in the cos^n lobe around the mirror direction. A

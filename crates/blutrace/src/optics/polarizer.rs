@@ -29,7 +29,7 @@
 //! traces it.
 
 use super::medium::Medium;
-use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::polarization::{
     Polarization, any_frame, block_direction, polarizer_reflection, polarizer_transmission,
 };
@@ -104,6 +104,10 @@ impl SurfaceSpecOf for PolarizerSpec {
 }
 
 impl Surface for Polarizer {
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Specular
+    }
+
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let normal = at.hit.normal;
         let pol = at.pol.unwrap_or_else(|| Polarization::unpolarized(at.dir));

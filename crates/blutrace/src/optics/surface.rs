@@ -41,7 +41,7 @@ use std::path::PathBuf;
 // Re-exported for the callers that name them along with the models (their homes are
 // `optics::model`, `optics::medium` and `crate::estimator`).
 pub use super::medium::{Interface, Medium, MediumId};
-pub use super::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+pub use super::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 pub use crate::estimator::Estimator;
 
 /// Generates [`SurfaceModel`], [`SurfaceSpec`] and their dispatch from the registry.
@@ -68,6 +68,21 @@ macro_rules! surface_models {
             pub fn interact_on(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
                 match self {
                     $( SurfaceModel::$Variant(m) => m.interact(at, rng), )*
+                }
+            }
+
+            /// What an event that met `feature` is to the luminance meter.
+            #[inline]
+            pub fn meter_vertex(&self, feature: Feature) -> MeterVertex {
+                match self {
+                    $( SurfaceModel::$Variant(m) => m.meter_vertex(feature), )*
+                }
+            }
+
+            /// The density of a diffuse event's light leaving along `out` (per sr).
+            pub fn meter_density(&self, at: &Arrival, feature: Feature, out: DVec3) -> f64 {
+                match self {
+                    $( SurfaceModel::$Variant(m) => m.meter_density(at, feature, out), )*
                 }
             }
 

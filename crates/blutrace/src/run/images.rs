@@ -113,23 +113,51 @@ pub(super) fn write_conoscope_png(run: &RunResult, path: &Path) -> Result<()> {
     write_polar(path, &grid, &opts)
 }
 
-/// `luminance.exr` and `luminance.png`: the luminance map within the detector's cone
-/// ([`metrics::cone`]); nothing without lumens or spectra.
+/// `luminance.exr` and `luminance.png`: the luminance map of the first view within the
+/// detector's cone ([`metrics::cone`]), and `luminance-view-K.exr`/`.png` of view K of
+/// several; nothing without lumens or spectra.
 pub(super) fn write_luminance_map(run: &RunResult, staged: &SetDir) -> Result<()> {
-    let Some(map) = metrics::cone::luminance_cone_map(&run.scene, &run.tally) else {
-        return Ok(());
-    };
-    let cone = run.scene.detector.luminance_cone_deg;
+    for k in 0..run.scene.detector.views.len() {
+        let Some(map) = metrics::cone::luminance_cone_map(&run.scene, &run.tally, k) else {
+            return Ok(());
+        };
+        let name = match k {
+            0 => "luminance".to_string(),
+            _ => format!("luminance-view-{k}"),
+        };
+        write_luminance_view(run, staged, &map, k, &name)?;
+    }
+    Ok(())
+}
+
+/// `NAME.exr` and `NAME.png`: the luminance map `map` of view `k`.
+fn write_luminance_view(
+    run: &RunResult,
+    staged: &SetDir,
+    map: &Map,
+    k: usize,
+    name: &str,
+) -> Result<()> {
+    let d = &run.scene.detector;
+    let cone = d.luminance_cone_deg;
+    let [theta, phi] = d.views[k];
+    let estimator = run.options.luminance_estimator.name().to_string();
     let mut attrs = map_attributes(
         run,
         "cd/m^2",
-        "blutrace luminance map: Y = luminance (cd/m^2) of the light leaving each bin \
-         within luminance_cone_deg of the detector normal, stderr.Y = its standard error, \
-         hits.Y = photons in the cone per bin; x along detector_u, y along detector_v",
+        &format!(
+            "blutrace luminance map: Y = luminance (cd/m^2) of the light leaving each bin \
+             within luminance_cone_deg of the view (theta_deg, phi_deg from the detector \
+             normal and detector_u), by the {estimator} estimator, stderr.Y = its standard \
+             error, hits.Y = photons that scored per bin; x along detector_u, y along detector_v"
+        ),
     );
     attrs.push(("luminance_cone_deg", Attribute::Text(cone.to_string())));
+    attrs.push(("view_theta_deg", Attribute::Text(theta.to_string())));
+    attrs.push(("view_phi_deg", Attribute::Text(phi.to_string())));
+    attrs.push(("luminance_estimator", Attribute::Text(estimator.clone())));
     let (value, stderr, hits) = (f32s(&map.value), f32s(&map.stderr), counts(&map.hits));
-    staged.write_with("luminance.exr", |path| {
+    staged.write_with(&format!("{name}.exr"), |path| {
         let channels = [
             ("Y", Samples::F32(&value)),
             ("stderr.Y", Samples::F32(&stderr)),
@@ -137,14 +165,18 @@ pub(super) fn write_luminance_map(run: &RunResult, staged: &SetDir) -> Result<()
         ];
         write_channels(path, map.nx, map.ny, &channels, &attrs)
     })?;
+    let view = match k {
+        0 if theta == 0.0 => "the normal".to_string(),
+        _ => format!("theta {theta} phi {phi} deg"),
+    };
     let title = format!(
-        "{}: luminance within {cone} deg of the normal, {} photons",
+        "{}: luminance within {cone} deg of {view}, {} photons",
         run.scene.name,
         thousands(run.tally.ledger.photons)
     );
     let unit = "luminance (cd/m²)";
-    staged.write_with("luminance.png", |path| {
-        write_target_png(path, map_on_target(run, &map), title.clone(), unit)
+    staged.write_with(&format!("{name}.png"), |path| {
+        write_target_png(path, map_on_target(run, map), title.clone(), unit)
     })?;
     Ok(())
 }

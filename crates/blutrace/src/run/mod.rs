@@ -27,6 +27,7 @@ mod rounds;
 pub mod summary;
 
 use crate::accel::{self, BackendChoice};
+use crate::estimator::LuminanceEstimator;
 use crate::optics::surface::Estimator;
 use crate::output::atomic::{OutputSet, SetDir};
 use crate::scene::{Scene, SharedScene};
@@ -90,6 +91,8 @@ pub struct RunOptions {
     pub backend: BackendChoice,
     /// How absorption is sampled.
     pub estimator: Estimator,
+    /// How the luminance maps are estimated.
+    pub luminance_estimator: LuminanceEstimator,
     /// Stop once the target metric's relative standard error is at or below this.
     pub target_error: Option<f64>,
     /// The metric `target_error` refers to.
@@ -163,6 +166,7 @@ impl Default for RunOptions {
             threads: None,
             backend: BackendChoice::Auto,
             estimator: Estimator::Analog,
+            luminance_estimator: LuminanceEstimator::Meter,
             target_error: None,
             target_metric: TargetMetric::Mean,
             max_time_s: None,
@@ -407,7 +411,8 @@ pub fn trace_reusing(
         options.estimator,
         options.convex,
         &built.facets,
-    );
+    )
+    .luminance_estimator(options.luminance_estimator);
     let mut state = Rounds::new(scene, options.photon_range());
     let start = Instant::now();
     let stopped_by = state.run(&pool, &tracer, scene, options, start, progress);

@@ -73,6 +73,12 @@ pub struct Summary {
     /// the sources give their lumens or spectra ([`super::metrics::cone`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub luminance_map: Option<LuminanceMapSummary>,
+    /// How the luminance maps were estimated ([`crate::estimator::LuminanceEstimator`]).
+    pub luminance_estimator: crate::estimator::LuminanceEstimator,
+    /// Every view's luminance map summary, when the detector has several views
+    /// (`luminance_map` is the first's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub luminance_views: Vec<LuminanceMapSummary>,
     /// The target light's colour and colour uniformity, when the sources have spectra
     /// ([`super::metrics::color`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -304,7 +310,16 @@ impl RunResult {
                         .collect(),
                 }
             }),
-            luminance_map: luminance_map_summary(&self.scene, &self.tally, &self.groups),
+            luminance_map: luminance_map_summary(&self.scene, &self.tally, &self.groups, 0),
+            luminance_estimator: self.options.luminance_estimator,
+            luminance_views: match d.views.len() {
+                1 => Vec::new(),
+                n => (0..n)
+                    .filter_map(|k| {
+                        luminance_map_summary(&self.scene, &self.tally, &self.groups, k)
+                    })
+                    .collect(),
+            },
             color: color_summary(&self.scene, &self.tally, &self.groups),
             polarization: polarization_summary(&self.tally, &self.groups),
             detector: DetectorSummary {

@@ -277,6 +277,12 @@ impl Scene {
         self.convex = convex_solids(self);
     }
 
+    /// Whether the run has luminance maps (and colour maps): the sources give lumens or
+    /// spectra.
+    pub fn luminous(&self) -> bool {
+        self.sources.spectral() || self.sources.luminous_efficacy().is_some()
+    }
+
     /// The convex solid of `medium`, when the fast path applies to it.
     pub fn convex_solid(&self, medium: MediumId) -> Option<&ConvexSolid> {
         self.convex.get(medium as usize)?.as_ref()

@@ -27,7 +27,7 @@ use super::body_boxes::BodyBoxes;
 use super::tir_run::TirRun;
 use super::{Photon, ROULETTE_BELOW, Tracer, absorb_clear, convex_solid, roulette};
 use crate::accel::convex::ConvexSolid;
-use crate::estimator::Estimator;
+use crate::estimator::{Estimator, LuminanceEstimator};
 use crate::geometry::{Ray, SpawnedRay, SurfaceHit};
 use crate::optics::dot_placement::ColumnRadii;
 use crate::optics::dots::DotPattern;
@@ -161,10 +161,23 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: facet.normal,
             };
-            let light = p.light;
+            let (light, before) = (p.light, p.weight);
             let (outcome, feature) =
                 self.face_step(tag, &surf, (ray.dir, medium, light), &mut p.pol, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
+            if self.luminance == Some(LuminanceEstimator::Meter) {
+                let model = &scene.surfaces[tag as usize];
+                let event = (before, feature);
+                self.walk_event(
+                    p,
+                    (model, tag),
+                    &surf,
+                    (ray.dir, medium),
+                    event,
+                    &outcome,
+                    out,
+                );
+            }
             let Outcome::Scattered {
                 dir,
                 medium: next,

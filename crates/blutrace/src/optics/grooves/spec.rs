@@ -7,7 +7,7 @@ use crate::optics::density::{
 };
 use crate::optics::dielectric;
 use crate::optics::medium::{Interface, Medium, air};
-use crate::optics::model::{Arrival, Face, Feature, Outcome, Surface, SurfaceSpecOf};
+use crate::optics::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use crate::rng::PhotonRng;
 use crate::spec_check::{Ctx, short};
 
@@ -70,6 +70,13 @@ pub struct Grooves {
 }
 
 impl Surface for Grooves {
+    /// Facets and the flat between them are specular; a facet turns the light's
+    /// direction across the face, which the meter's peel-off path notices and leaves to
+    /// the cone count.
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        MeterVertex::Specular
+    }
+
     #[inline]
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {
         let i = &self.interface;

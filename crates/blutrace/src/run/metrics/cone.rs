@@ -22,10 +22,10 @@ use crate::scene::Scene;
 use crate::tally::{Grid, Sign, Tally};
 use serde::Serialize;
 
-/// The cone grid of `t` and the lumens per unit of its weight (`None`: no lumens or
-/// spectra).
-fn cone_grid<'t>(scene: &Scene, t: &'t Tally) -> Option<(&'t Grid, f64)> {
-    let g = t.cone.as_ref()?;
+/// The meter's grid of view `k` in `t` and the lumens per unit of its weight (`None`:
+/// no lumens or spectra).
+fn cone_grid<'t>(scene: &Scene, t: &'t Tally, k: usize) -> Option<(&'t Grid, f64)> {
+    let g = t.meter.as_ref()?.luminous(k);
     let efficacy = match &t.color {
         Some(_) => KM_LM_PER_W,
         None => scene.sources.luminous_efficacy()?,
@@ -33,10 +33,10 @@ fn cone_grid<'t>(scene: &Scene, t: &'t Tally) -> Option<(&'t Grid, f64)> {
     Some((g, efficacy))
 }
 
-/// The luminance map of `grid` over `photons` photons (cd/m² per bin).
-fn map_of(scene: &Scene, grid: &Grid, photons: u64, efficacy: f64) -> Map {
+/// The luminance map of view `k`'s `grid` over `photons` photons (cd/m² per bin).
+fn map_of(scene: &Scene, grid: &Grid, photons: u64, efficacy: f64, k: usize) -> Map {
     let d = &scene.detector;
-    let per_bin = d.bin_area() * 1e-6 * d.cone_projected_solid_angle();
+    let per_bin = d.bin_area() * 1e-6 * d.cone_projected_solid_angle(k);
     let k = scene.sources.total_power() * efficacy / per_bin;
     let mut m = Map {
         nx: grid.nx,
@@ -54,10 +54,10 @@ fn map_of(scene: &Scene, grid: &Grid, photons: u64, efficacy: f64) -> Map {
     m
 }
 
-/// The luminance map (cd/m² per bin), or `None` without lumens or spectra.
-pub fn luminance_cone_map(scene: &Scene, t: &Tally) -> Option<Map> {
-    let (g, efficacy) = cone_grid(scene, t)?;
-    Some(map_of(scene, g, t.ledger.photons, efficacy))
+/// The luminance map of view `k` (cd/m² per bin), or `None` without lumens or spectra.
+pub fn luminance_cone_map(scene: &Scene, t: &Tally, k: usize) -> Option<Map> {
+    let (g, efficacy) = cone_grid(scene, t, k)?;
+    Some(map_of(scene, g, t.ledger.photons, efficacy, k))
 }
 
 /// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity. When no
@@ -65,9 +65,14 @@ pub fn luminance_cone_map(scene: &Scene, t: &Tally) -> Option<Map> {
 /// estimate is NaN (`null`), not 0 ± 0 cd/m².
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LuminanceMapSummary {
+    /// The view: polar angle from the detector normal and azimuth from its u axis
+    /// (degrees).
+    pub view_deg: [f64; 2],
     /// Half-angle of the cone (degrees).
     pub cone_deg: f64,
-    /// Photons that left the target within the cone (over every bin).
+    /// Photons that scored in the map (over every bin): under the cone estimator those
+    /// that left the target within the cone; under the meter's also those whose peel-off
+    /// reached it.
     pub photons_in_cone: u64,
     /// Mean luminance over the target (cd/m²).
     pub mean_cd_m2: Estimate,
@@ -86,30 +91,57 @@ pub struct LuminanceMapSummary {
     pub nine_point_min_over_max: Estimate,
     /// Min over max of the 13 standard spots.
     pub thirteen_point_min_over_max: Estimate,
+    /// Of the light every view's meter read, the fraction the cone count scored rather
+    /// than the peel-off (1 under the cone estimator; NaN when the meter read nothing).
+    pub cone_counted_fraction: f64,
+    /// What kept the peel-off from most of that light: a surface (`surfaces.TAG`: a
+    /// model whose density is not evaluated, or faces that turn the light, such as
+    /// grooves), a lamp body, `emission`, `volume scattering` or `a solid's walk`.
+    pub cone_counted_mostly: Option<String>,
 }
 
-/// The luminance map's summary with jackknife errors over `groups` (`None` without
-/// lumens or spectra).
+/// The name of the cause `k` of [`crate::tally::MeterTally::counted`].
+fn cause_name(scene: &Scene, k: usize) -> String {
+    let tags = scene.tags.len();
+    let bodies = scene.sources.list.len();
+    if k < tags {
+        return format!("surfaces.{}", scene.tags[k]);
+    }
+    if k < tags + bodies {
+        return format!("the lamp body of {}", scene.sources.list[k - tags].name);
+    }
+    let causes = crate::tally::meter::Cause::ALL;
+    match causes[k - tags - bodies] {
+        crate::tally::meter::Cause::Emission => "emission (no diffuse event)".into(),
+        crate::tally::meter::Cause::Volume => "volume scattering".into(),
+        crate::tally::meter::Cause::TurnedInWalk => "a face within a light guide's walk".into(),
+    }
+}
+
+/// The luminance map's summary of view `k` with jackknife errors over `groups` (`None`
+/// without lumens or spectra).
 pub fn luminance_map_summary(
     scene: &Scene,
     total: &Tally,
     groups: &[Tally],
+    k: usize,
 ) -> Option<LuminanceMapSummary> {
-    let (grid, efficacy) = cone_grid(scene, total)?;
+    let (grid, efficacy) = cone_grid(scene, total, k)?;
     let n = total.ledger.photons;
     let metrics = |m: &Map| Metrics::of_flux(m.nx, m.ny, &m.value, &m.stderr, f64::NAN);
-    let own = metrics(&map_of(scene, grid, n, efficacy));
+    let own = metrics(&map_of(scene, grid, n, efficacy, k));
     let leave_out: Vec<Metrics> = groups
         .iter()
         .filter(|g| g.ledger.photons > 0)
         .filter_map(|g| {
             let mut rest = grid.clone();
-            rest.merge_signed(g.cone.as_ref()?, Sign::Remove);
+            rest.merge_signed(g.meter.as_ref()?.luminous(k), Sign::Remove);
             Some(metrics(&map_of(
                 scene,
                 &rest,
                 n - g.ledger.photons,
                 efficacy,
+                k,
             )))
         })
         .collect();
@@ -125,7 +157,14 @@ pub fn luminance_map_summary(
             stderr: jackknife_stderr(&leave_out.iter().map(|l| l.values()[m]).collect::<Vec<_>>()),
         },
     };
+    let meter = total.meter.as_ref()?;
+    let counted = meter.counted_fraction();
     Some(LuminanceMapSummary {
+        cone_counted_fraction: counted.map_or(f64::NAN, |c| c.0),
+        cone_counted_mostly: counted
+            .filter(|c| c.0 > 0.0)
+            .map(|(_, top)| cause_name(scene, top)),
+        view_deg: scene.detector.views[k],
         cone_deg: scene.detector.luminance_cone_deg,
         photons_in_cone,
         mean_cd_m2: est(Metric::Mean),

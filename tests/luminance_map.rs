@@ -63,7 +63,7 @@ fn the_maps_mean_is_the_angular_outputs_on_axis_luminance() {
     let (map, axis) = (s.luminance_map.unwrap(), s.luminance.unwrap());
     let rel = (map.mean_cd_m2.value - axis.on_axis_cd_m2).abs() / axis.on_axis_cd_m2;
     assert!(rel < 1e-9, "{:?} vs {}", map.mean_cd_m2, axis.on_axis_cd_m2);
-    let cone_hits: u64 = luminance_cone_map(&run.scene, &run.tally)
+    let cone_hits: u64 = luminance_cone_map(&run.scene, &run.tally, 0)
         .unwrap()
         .hits
         .iter()
@@ -77,7 +77,7 @@ fn the_maps_mean_is_the_angular_outputs_on_axis_luminance() {
 fn the_map_does_not_depend_on_threads_and_is_written() {
     let scene = panel("lum-threads", "");
     let (a, b) = (trace(&scene, 100_000, 9, 1), trace(&scene, 100_000, 9, 3));
-    assert_eq!(a.tally.cone, b.tally.cone);
+    assert_eq!(a.tally.meter, b.tally.meter);
     assert_eq!(a.summary().luminance_map, b.summary().luminance_map);
     assert_eq!(a.summary().luminance_map.unwrap().cone_deg, 2.0);
     let dir = temp_folder("lum-out");
@@ -111,7 +111,7 @@ fn cones_are_checked_and_a_run_without_lumens_has_no_map() {
         width_mm = 1.0\nheight_mm = 1.0\npower_w = 1.0\n\
         [detector]\norigin = [-5.0, -5.0, 0.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 1.0, 0.0]\nsize_mm = [10.0, 10.0]\n";
     let run = trace(&load(&write_scene("lum-none", toml, &[])), 1000, 1, 1);
-    assert!(run.tally.cone.is_none() && run.summary().luminance_map.is_none());
+    assert!(run.tally.meter.is_none() && run.summary().luminance_map.is_none());
 }
 
 /// `trace --luminance-cone-deg` replaces the scene's cone, is checked, and is refused with
@@ -132,8 +132,13 @@ fn the_command_lines_cone_replaces_the_scenes_and_is_checked() {
     let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
     let s: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(s["luminance_map"]["cone_deg"], 10.0);
-    // No photon in the narrowest cone: the map measured nothing, and says so.
-    let empty = run(&["--luminance-cone-deg", "0.001"]);
+    // No photon in the narrowest cone: the cone count measured nothing, and says so.
+    let empty = run(&[
+        "--luminance-cone-deg",
+        "0.001",
+        "--luminance-estimator",
+        "cone",
+    ]);
     let said = String::from_utf8_lossy(&empty.stdout);
     assert!(empty.status.success(), "{said}");
     assert!(

@@ -483,7 +483,7 @@ fn print_luminance_map(m: &LuminanceMapSummary, estimator: LuminanceEstimator, p
     };
     if m.photons_in_cone == 0 {
         say!(
-            "note       no photon reached the luminance meter ({}° cone) in {photons} photons: the luminance map measured nothing (null in summary.json, not 0 cd/m²); a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
+            "note       no photon left the target within the {}° cone in {photons} photons: the luminance map measured nothing (null in summary.json, not 0 cd/m²); a noise floor of 0.1 needs {needed}, or widen --luminance-cone-deg",
             m.cone_deg,
         );
         return;

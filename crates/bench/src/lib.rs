@@ -30,6 +30,7 @@
 pub mod box_scene;
 pub mod cavity;
 pub mod load;
+pub mod luminance;
 pub mod polarization;
 pub mod reference;
 pub mod reference_before;

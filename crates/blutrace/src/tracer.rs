@@ -658,6 +658,7 @@ fn assert_same_chunks_of(
             assert_eq!(a.detections, b.detections, "{what}");
             assert_eq!(a.stokes, b.stokes, "{what}");
             assert_eq!(a.meter, b.meter, "{what}");
+            assert_eq!((a.peeled, &a.counted), (b.peeled, &b.counted), "{what}");
             a
         })
         .into()

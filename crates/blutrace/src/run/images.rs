@@ -149,7 +149,9 @@ fn write_luminance_view(
             "blutrace luminance map: Y = luminance (cd/m^2) of the light leaving each bin \
              within luminance_cone_deg of the view (theta_deg, phi_deg from the detector \
              normal and detector_u), by the {estimator} estimator, stderr.Y = its standard \
-             error, hits.Y = photons that scored per bin; x along detector_u, y along detector_v"
+             error, hits.Y = photons that scored per bin; in a spectral run also X, Z on Y's \
+             scale with their errors and u_prime, v_prime (CIE 1976); x along detector_u, y \
+             along detector_v"
         ),
     );
     attrs.push(("luminance_cone_deg", Attribute::Text(cone.to_string())));
@@ -157,12 +159,16 @@ fn write_luminance_view(
     attrs.push(("view_phi_deg", Attribute::Text(phi.to_string())));
     attrs.push(("luminance_estimator", Attribute::Text(estimator.clone())));
     let (value, stderr, hits) = (f32s(&map.value), f32s(&map.stderr), counts(&map.hits));
+    let colour = view_colour(run, k);
     staged.write_with(&format!("{name}.exr"), |path| {
-        let channels = [
+        let mut channels = vec![
             ("Y", Samples::F32(&value)),
             ("stderr.Y", Samples::F32(&stderr)),
             ("hits.Y", Samples::F32(&hits)),
         ];
+        for (name, c) in &colour {
+            channels.push((name, Samples::F32(c)));
+        }
         write_channels(path, map.nx, map.ny, &channels, &attrs)
     })?;
     let view = match k {
@@ -179,6 +185,33 @@ fn write_luminance_view(
         write_target_png(path, map_on_target(run, map), title.clone(), unit)
     })?;
     Ok(())
+}
+
+/// In a spectral run, view `k`'s `X`, `Z` (on `Y`'s cd/m² scale), their errors and
+/// `u_prime`, `v_prime` per bin (NaN where no light), as EXR channels.
+fn view_colour(run: &RunResult, k: usize) -> Vec<(&'static str, Vec<f32>)> {
+    let Some(xyz) = metrics::cone::view_xyz_maps(&run.scene, &run.tally, k) else {
+        return Vec::new();
+    };
+    let uv: Vec<[f64; 2]> = (0..xyz[0].value.len())
+        .map(|i| {
+            let c = crate::color::Xyz {
+                x: xyz[0].value[i],
+                y: xyz[1].value[i],
+                z: xyz[2].value[i],
+            };
+            c.uv_prime().map_or([f64::NAN; 2], |p| [p.u, p.v])
+        })
+        .collect();
+    let part = |i: usize| uv.iter().map(|p| p[i]).collect::<Vec<_>>();
+    vec![
+        ("X", f32s(&xyz[0].value)),
+        ("Z", f32s(&xyz[2].value)),
+        ("stderr.X", f32s(&xyz[0].stderr)),
+        ("stderr.Z", f32s(&xyz[2].stderr)),
+        ("u_prime", f32s(&part(0))),
+        ("v_prime", f32s(&part(1))),
+    ]
 }
 
 /// `stokes.exr`, when polarization is traced: `S0` (the flux map) to `S3` per bin with

@@ -388,6 +388,22 @@ mod tests {
         }
     }
 
+    /// The same under the luminance meter's estimator: the walk calls its hooks at the
+    /// same events, so the meter's hits and their causes are the same bits too.
+    #[test]
+    fn the_walk_peels_off_as_the_general_loop_does() {
+        let meter = |t: &mut Tracer| {
+            t.walks.runs.iter_mut().for_each(|r| *r = None);
+            t.luminance = Some(LuminanceEstimator::Meter);
+        };
+        for name in ["notebook14", "notebook14-color"] {
+            let chunks = assert_same_chunks(name, Estimator::Analog, meter, |general| {
+                general.walks.solids.iter_mut().for_each(|s| *s = None);
+            });
+            assert!(chunks.iter().all(|c| c.meter.len() > 1000), "{name}");
+        }
+    }
+
     /// The same with polarization traced: the walk carries the state exactly as the
     /// general loop does (Stokes vectors of every detection equal too; runs off, as above).
     #[test]

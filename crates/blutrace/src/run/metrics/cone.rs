@@ -60,6 +60,42 @@ pub fn luminance_cone_map(scene: &Scene, t: &Tally, k: usize) -> Option<Map> {
     Some(map_of(scene, g, t.ledger.photons, efficacy, k))
 }
 
+/// X, Y, Z maps of view `k` on the luminance map's scale (Y in cd/m²), in a spectral
+/// run with a luminance map.
+pub fn view_xyz_maps(scene: &Scene, t: &Tally, k: usize) -> Option<[Map; 3]> {
+    let grids = t.meter.as_ref()?.xyz(k)?;
+    let n = t.ledger.photons;
+    Some(grids.map(|g| map_of(scene, g, n, KM_LM_PER_W, k)))
+}
+
+/// The chromaticity u', v' of view `k`'s whole map, with jackknife errors over
+/// `groups`, in a spectral run.
+fn view_chromaticity(t: &Tally, groups: &[Tally], k: usize) -> Option<[Estimate; 2]> {
+    let sums = |t: &Tally| -> Option<[f64; 3]> {
+        let g = t.meter.as_ref()?.xyz(k)?;
+        Some(g.map(|g| g.bins.iter().map(|b| b.sum.value()).sum()))
+    };
+    let uv = |s: [f64; 3]| {
+        let xyz = crate::color::Xyz {
+            x: s[0],
+            y: s[1],
+            z: s[2],
+        };
+        xyz.uv_prime().map_or([f64::NAN; 2], |p| [p.u, p.v])
+    };
+    let total = sums(t)?;
+    let leave_out: Vec<[f64; 2]> = groups
+        .iter()
+        .filter_map(sums)
+        .map(|g| uv([0, 1, 2].map(|i| total[i] - g[i])))
+        .collect();
+    let own = uv(total);
+    Some([0, 1].map(|i| Estimate {
+        value: own[i],
+        stderr: jackknife_stderr(&leave_out.iter().map(|l| l[i]).collect::<Vec<_>>()),
+    }))
+}
+
 /// `summary.json`'s `luminance_map`: the luminance map's mean and uniformity. When no
 /// photon fell within the cone (`photons_in_cone` 0) the map measured nothing: every
 /// estimate is NaN (`null`), not 0 ± 0 cd/m².
@@ -94,6 +130,9 @@ pub struct LuminanceMapSummary {
     /// Of the light every view's meter read, the fraction the cone count scored rather
     /// than the peel-off (1 under the cone estimator; NaN when the meter read nothing).
     pub cone_counted_fraction: f64,
+    /// CIE 1976 u' and v' of the whole map's light, in a spectral run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uv_prime: Option<[Estimate; 2]>,
     /// What kept the peel-off from most of that light: a surface (`surfaces.TAG`: a
     /// model whose density is not evaluated, or faces that turn the light, such as
     /// grooves), a lamp body, `emission`, `volume scattering` or `a solid's walk`.
@@ -160,6 +199,7 @@ pub fn luminance_map_summary(
     let meter = total.meter.as_ref()?;
     let counted = meter.counted_fraction();
     Some(LuminanceMapSummary {
+        uv_prime: view_chromaticity(total, groups, k),
         cone_counted_fraction: counted.map_or(f64::NAN, |c| c.0),
         cone_counted_mostly: counted
             .filter(|c| c.0 > 0.0)

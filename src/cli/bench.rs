@@ -1,7 +1,7 @@
 //! `blutrace bench`: photons/s per backend as Markdown tables (ratios measured in one run).
 
 use anyhow::{Result, bail};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Both scenes are there before anything is timed: errors name the option and the path
 /// given (the box scene's default is derived from `--scene`, so a wrong `--scene` is named
@@ -143,7 +143,48 @@ pub(super) fn bench(
     }
     say!();
     reader_still_there()?;
-    polarization_table(&[box_scene, scene], photons, threads, repeat)
+    polarization_table(&[box_scene, scene], photons, threads, repeat)?;
+    say!();
+    reader_still_there()?;
+    print_luminance_estimators(scene, photons, threads, repeat)
+}
+
+/// The luminance map's estimators on every bundled scene beside `scene` that has one.
+fn print_luminance_estimators(
+    scene: &Path,
+    photons: u64,
+    threads: Option<usize>,
+    repeat: usize,
+) -> Result<()> {
+    let root = scene.parent().unwrap_or(Path::new("."));
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root)?
+        .filter_map(|e| Some(e.ok()?.path()))
+        .filter(|p| p.join("scene.toml").is_file())
+        .collect();
+    dirs.sort();
+    let dirs: Vec<&Path> = dirs.iter().map(PathBuf::as_path).collect();
+    let rows = blutrace_bench::luminance::luminance_table(&dirs, photons, threads, repeat)?;
+    say!(
+        "| luminance map, 2° cone | estimator | photons | seconds | noise floor | mean error | cone-counted | FOM 1/(floor²·s) | FOM ratio |"
+    );
+    say!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    for pair in rows.chunks(2) {
+        for r in pair {
+            say!(
+                "| {} | {} | {} | {:.2} | {:.3} | {:.2e} | {:.3} | {:.3e} | {:.1} |",
+                r.scene,
+                r.estimator.name(),
+                r.photons,
+                r.seconds,
+                r.noise_floor,
+                r.mean_rel_error,
+                r.cone_counted,
+                r.fom_map,
+                r.fom_map / pair[0].fom_map
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The cost of polarized transport on `dirs` (see `blutrace_bench::polarization`).

@@ -54,7 +54,7 @@ use super::spectrum::{EmissionSpectrum, SpectrumSpec, VISIBLE_NM};
 use crate::color::Spectrum;
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::optics::medium::air;
-use crate::scene::geometry_file::{Units, affine_matrix, rotation_deg};
+use crate::transform::{Units, affine_matrix, rotation_deg};
 use crate::sources::MAX_TOTAL_POWER_W;
 use crate::spec_check::{Ctx, short};
 use anyhow::{Result, bail};

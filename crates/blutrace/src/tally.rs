@@ -301,6 +301,9 @@ pub struct Ledger {
     /// Weight absorbed per source, by its lamp body.
     #[serde(default)]
     pub absorbed_by_source: Vec<ExactSum>,
+    /// Weight the detector's analyzer absorbed (`[detector] analyzer_deg`; zero without).
+    #[serde(default)]
+    pub absorbed_by_analyzer: ExactSum,
     /// Weight that left the scene.
     pub escaped: ExactSum,
     /// Weight stopped by the bounce cap.
@@ -447,6 +450,7 @@ impl Ledger {
                 weight(a, *b)?;
             }
         }
+        weight(&mut self.absorbed_by_analyzer, o.absorbed_by_analyzer)?;
         weight(&mut self.escaped, o.escaped)?;
         weight(&mut self.killed, o.killed)?;
         count(&mut self.killed_photons, o.killed_photons)?;
@@ -455,7 +459,14 @@ impl Ledger {
 
     /// [`Ledger::accounted`], or `None` past the `i128` range (a damaged file's ledger).
     pub fn checked_accounted(&self) -> Option<ExactSum> {
-        [self.detected.sum, self.escaped, self.killed, self.roulette]
+        let sinks = [
+            self.detected.sum,
+            self.absorbed_by_analyzer,
+            self.escaped,
+            self.killed,
+            self.roulette,
+        ];
+        sinks
             .iter()
             .chain(&self.absorbed_by_surface)
             .chain(&self.absorbed_in_medium)

@@ -26,8 +26,8 @@
 
 pub use super::meshio::Format;
 use super::meshio::{ReadCache, TaggedTriangles};
-pub use crate::transform::Units;
 use crate::spec_check::Ctx;
+pub use crate::transform::Units;
 use crate::transform::{affine_matrix, rotation_deg, rotation_x};
 use anyhow::Result;
 use glam::{DMat3, DMat4};

@@ -706,11 +706,16 @@ impl Tally {
 
 /// Whether a Stokes grid could not come from a run of `photons` photons: a bin whose
 /// squares sum is negative, whose sum exceeds what its squares allow (`sum^2 <= hits *
-/// sumsq`, Cauchy-Schwarz), or that holds more photons than were emitted.
+/// sumsq`, Cauchy-Schwarz, up to the rounding of each term to the sums' grid: a nearly
+/// unpolarized photon's `S1 w` of 1e-12 adds its value to the sum but its square, below
+/// the grid, nothing to the squares), or that holds more photons than were emitted.
 fn bad_stokes(g: &Grid, photons: u64) -> bool {
     g.bins.iter().any(|b| {
-        let (sum, sumsq) = (b.sum.value(), b.sumsq.value());
-        b.sumsq.0 < 0 || b.hits > photons || sum * sum > 1.000001 * sumsq * b.hits as f64
+        let hits = b.hits as f64;
+        let grid = hits * 2f64.powi(-FRACTION_BITS);
+        let sum = (b.sum.value().abs() - grid).max(0.0);
+        let sumsq = b.sumsq.value() + grid;
+        b.sumsq.0 < 0 || b.hits > photons || sum * sum > 1.000001 * sumsq * hits
     })
 }
 

@@ -59,6 +59,7 @@ fn led_rays(scene: &Scene, n: usize) -> RaySet {
         table: Vec::new(),
         spectrum: FileSpectrum::None,
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     }
 }
@@ -276,6 +277,7 @@ fn scene_errors_name_the_entry_the_file_and_the_byte() {
         table: Vec::new(),
         spectrum: FileSpectrum::None,
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     };
     let file = dir.path().join("x.TM25RAY");
@@ -322,6 +324,7 @@ fn check_prints_the_ray_file() {
         table: Vec::new(),
         spectrum: FileSpectrum::Table(vec![[440.0, 0.0], [450.0, 1.0], [460.0, 0.0]]),
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     };
     tm25::write(&dir.path().join("x.TM25RAY"), &set).unwrap();
@@ -368,6 +371,7 @@ fn two_table_set() -> RaySet {
             vec![[480.0, 0.5], [560.0, 1.0], [650.0, 0.25], [700.0, 0.0]],
         ]),
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     }
 }
@@ -442,6 +446,7 @@ fn photons_trace_with_their_rays_tables() {
             vec![[600.0, 1.0], [650.0, 1.0]],
         ]),
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     };
     let dir = write_scene(

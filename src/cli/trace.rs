@@ -281,11 +281,12 @@ fn print_report(s: &run::summary::Summary, files: &[PathBuf]) {
         s.interactions_per_s
     );
     say!(
-        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + lamp bodies {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
+        "ledger     emitted {:.4} W = detected {:.4} + absorbed {:.4} + lamp bodies {:.4} + analyzer {:.4} + escaped {:.4} + killed {:.4} + roulette {:.4}  (balance error {:.1e})",
         l.emitted_w,
         l.detected_w,
         absorbed,
         lamps,
+        l.absorbed_by_analyzer_w,
         l.escaped_w,
         l.killed_w,
         l.roulette_w,

@@ -211,6 +211,12 @@ fn axis_of(v: DVec3) -> Option<(usize, f32)> {
 impl BoxScene {
     /// Read the box-guide scene from `scene`, or say why it is not one.
     pub fn from_scene(scene: &Scene) -> Result<BoxScene> {
+        if scene.polarized {
+            bail!(refuse(
+                scene,
+                "it traces polarization: the kernel averages Fresnel over s and p ([trace] polarization = false)"
+            ));
+        }
         if scene.media.len() != 2 {
             bail!(refuse(scene, "it needs exactly one medium besides air"));
         }

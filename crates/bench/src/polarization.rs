@@ -1,6 +1,7 @@
-//! The cost of polarized transport: each scene traced as loaded (averaged Fresnel, the
-//! convex-solid walks) and with `[trace] polarization` on (Stokes vectors, exact Fresnel,
-//! every event through the general loop), the same photons, interleaved rounds.
+//! The cost of polarized transport: each scene traced with the averaged Fresnel
+//! (`[trace] polarization = false`, bench-box's setting) and polarized (Stokes vectors,
+//! exact Fresnel: the default of every scene with a dielectric face), the same photons,
+//! interleaved rounds.
 
 use anyhow::Result;
 use blutrace::run::metrics::median;
@@ -13,7 +14,7 @@ use std::path::Path;
 pub struct PolarizationRow {
     /// The scene folder.
     pub scene: String,
-    /// Photons/s with the averaged Fresnel (the scene as loaded, polarization off).
+    /// Photons/s with the averaged Fresnel (polarization off).
     pub averaged_per_s: f64,
     /// Photons/s with polarization traced.
     pub polarized_per_s: f64,

@@ -10,6 +10,7 @@
 //! angular_bins = [18, 36]    # theta over [0, 90] deg from the normal, phi over [0, 360)
 //! luminance_cone_deg = 2.0   # half-angle of the luminance map's cone about each view
 //! views = [[0.0, 0.0], [45.0, 0.0]]  # [theta_deg, phi_deg] of each luminance map; default the normal
+//! analyzer_deg = 90.0        # optional: the panel's rear polarizer's transmission axis
 //! ```
 //!
 //! The luminance map (cd/m², with lumens or spectra) counts the light leaving each bin
@@ -27,11 +28,20 @@
 //! a rounding artefact (at 1e-300 degrees its solid angle underflows to 0 and the map to
 //! 0/0).
 //!
+//! `analyzer_deg = A` puts an ideal absorbing polarizer in front of the target (the
+//! panel's rear polarizer): its transmission axis lies in the target plane at `A` degrees
+//! from `u` towards `v`. Light along `d` meets the axis made perpendicular to `d` (as the
+//! detector's frame is) and passes `(S0 + S1) / 2` of its Stokes vector in that frame
+//! ([`TargetPlane::analyzer_transmittance`]); every detection is weighted by it, so the
+//! flux, luminance, colour and Stokes outputs all see the analyzer, and the rest is booked
+//! as `absorbed_by_analyzer_w`. An analyzer makes the scene trace polarization
+//! (`[trace] polarization = false` with one is an error).
+//!
 //! A photon crossing the rectangle along the normal (from the back, towards the viewer)
 //! is detected and stops there; one crossing the other way passes through.
 
 use crate::geometry::Ray;
-use crate::optics::polarization::Polarization;
+use crate::optics::polarization::{Polarization, Stokes};
 use crate::spec_check::Ctx;
 use anyhow::Result;
 use glam::DVec3;
@@ -59,6 +69,10 @@ pub struct DetectorSpec {
     /// Half-angle (degrees) of the luminance map's cone about the normal.
     #[serde(default = "default_luminance_cone_deg")]
     pub luminance_cone_deg: f64,
+    /// Transmission axis (degrees from `u` towards `v`) of an ideal absorbing polarizer
+    /// in front of the target; none by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub analyzer_deg: Option<f64>,
     /// The directions a luminance meter looks from, `[theta_deg, phi_deg]` (theta from
     /// the normal, phi from u towards v): one luminance map each. Default: the normal.
     #[serde(default = "default_views")]
@@ -106,7 +120,18 @@ impl DetectorSpec {
         let cone = d.luminance_cone_deg;
         check_cone(cone).map_err(|e| ctx.err("detector.luminance_cone_deg", e))?;
         check_views(&d.views, cone).map_err(|e| ctx.err("detector.views", e))?;
+        let analyzer = match d.analyzer_deg {
+            Some(a) => {
+                let (s, c) = ctx
+                    .angle_deg("detector.analyzer_deg", a)?
+                    .to_radians()
+                    .sin_cos();
+                Some(u * c + v * s)
+            }
+            None => None,
+        };
         Ok(TargetPlane {
+            analyzer,
             luminance_cone_deg: cone,
             cone_cos: cone.to_radians().cos(),
             views: d.views.clone(),
@@ -195,6 +220,8 @@ pub struct TargetPlane {
     pub cone_cos: f64,
     /// The luminance maps' views, `[theta_deg, phi_deg]` ([`DetectorSpec::views`]).
     pub views: Vec<[f64; 2]>,
+    /// The unit transmission axis of the analyzer in front of the target, if any.
+    pub analyzer: Option<DVec3>,
 }
 
 impl TargetPlane {
@@ -378,15 +405,43 @@ impl TargetPlane {
         0.5 * (t1.sin().powi(2) - t0.sin().powi(2)) * TAU / np as f64
     }
 
-    /// The state `pol` of light detected along unit `dir`, as `(S1, S2, S3) / S0` in the
-    /// detector's frame: `u` made perpendicular to `dir` (`S1 > 0` along it), `v = dir x u`
-    /// (at grazing `dir` along `u`, `v` made perpendicular instead).
+    /// The state of light detected along unit `dir` in state `pol`, past the analyzer if
+    /// there is one, as `(S1, S2, S3) / S0` in the detector's frame: `u` made perpendicular
+    /// to `dir` (`S1 > 0` along it), `v = dir x u` (at grazing `dir` along `u`, `v` made
+    /// perpendicular instead).
     pub fn stokes_of(&self, pol: &Polarization, dir: DVec3) -> [f64; 3] {
         let frame = (self.u - self.u.dot(dir) * dir)
             .try_normalize()
             .unwrap_or_else(|| dir.cross(self.v).normalize());
-        let [_, s1, s2, s3] = pol.stokes_in(dir, frame).0;
+        let state = match self.analyzer_axis(dir) {
+            // What passes an ideal polarizer is polarized along its axis.
+            Some(t) => Stokes::linear_deg(0.0).reframed(dir, t, frame),
+            None => pol.stokes_in(dir, frame),
+        };
+        let [_, s1, s2, s3] = state.0;
         [s1, s2, s3]
+    }
+
+    /// The fraction of light along unit `dir` in state `pol` that the analyzer passes: 1
+    /// without one, else `(S0 + S1) / 2` of the state referred to the analyzer's axis made
+    /// perpendicular to `dir` (Malus's `cos^2` for linear light, 1/2 for unpolarized), 0
+    /// for light travelling along the axis (its field is all across it). Every estimator of
+    /// light on the target weights its detections by it.
+    pub fn analyzer_transmittance(&self, pol: &Polarization, dir: DVec3) -> f64 {
+        if self.analyzer.is_none() {
+            return 1.0;
+        }
+        match self.analyzer_axis(dir) {
+            Some(t) => (0.5 * (1.0 + pol.stokes_in(dir, t).0[1])).clamp(0.0, 1.0),
+            None => 0.0,
+        }
+    }
+
+    /// The analyzer's axis made perpendicular to unit `dir` (`None`: no analyzer, or
+    /// `dir` along its axis).
+    fn analyzer_axis(&self, dir: DVec3) -> Option<DVec3> {
+        let a = self.analyzer?;
+        (a - a.dot(dir) * dir).try_normalize()
     }
 }
 
@@ -405,6 +460,7 @@ mod tests {
             luminance_cone_deg: 2.0,
             cone_cos: 2.0f64.to_radians().cos(),
             views: vec![[0.0, 0.0], [30.0, 90.0]],
+            analyzer: None,
         }
     }
 

@@ -30,3 +30,4 @@ pub mod sources;
 pub mod spec_check;
 pub mod tally;
 pub mod tracer;
+pub mod transform;

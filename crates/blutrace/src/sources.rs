@@ -29,6 +29,7 @@ pub mod spectrum;
 
 use crate::geometry::Ray;
 use crate::optics::medium::{Medium, MediumId, medium_id};
+use crate::optics::polarization::Polarization;
 use crate::optics::spectrum::Light;
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -259,24 +260,31 @@ pub enum Emitter {
 impl Emitter {
     /// A photon leaving the emitter: its ray and the emitting surface's normal.
     pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3) {
-        let (ray, normal, _) = self.emit_nm(rng);
+        let (ray, normal, _, _) = self.emit_own(rng);
         (ray, normal)
     }
 
-    /// [`Emitter::emit`], with the photon's own wavelength (nm) when the emitter gives
-    /// one (a ray file's ray), else `None` (the source's spectrum, if any, draws it).
-    pub fn emit_nm(&self, rng: &mut PhotonRng) -> (Ray, DVec3, Option<f64>) {
+    /// [`Emitter::emit`], with the photon's own wavelength (nm) and polarization when the
+    /// emitter gives them (a ray file's ray), else `None` (the source's spectrum and
+    /// polarization, if any, give them).
+    pub fn emit_own(&self, rng: &mut PhotonRng) -> (Ray, DVec3, Option<f64>, Option<Polarization>) {
         match self {
             Emitter::Ccfl(t) => {
                 let (ray, n) = t.emit(rng);
-                (ray, n, None)
+                (ray, n, None, None)
             }
             Emitter::Led(l) => {
                 let (ray, n) = l.emit(rng);
-                (ray, n, None)
+                (ray, n, None, None)
             }
-            Emitter::RayFile(r) => r.emit(rng),
+            Emitter::RayFile(r) => r.emit_polarized(rng),
         }
+    }
+
+    /// Whether the emitter gives its photons their polarization (a ray file with Stokes
+    /// columns).
+    pub fn polarized(&self) -> bool {
+        matches!(self, Emitter::RayFile(r) if !r.set.stokes.is_empty())
     }
 
     /// The spectrum the emitter itself gives (a ray file's table or wavelengths; `Err`:
@@ -417,6 +425,9 @@ pub struct Emission {
     pub source: usize,
     /// Its light (see [`crate::optics::spectrum`]).
     pub light: Light,
+    /// Its polarization when its emitter gives it (a ray file's Stokes columns), else
+    /// the source's `polarization`, if any, gives it.
+    pub pol: Option<Polarization>,
 }
 
 impl Source {
@@ -535,7 +546,7 @@ impl Sources {
             .partition_point(|&c| c <= u)
             .min(self.list.len() - 1);
         let s = &self.list[i];
-        let (ray, normal, own_nm) = s.emitter.emit_nm(rng);
+        let (ray, normal, own_nm, pol) = s.emitter.emit_own(rng);
         let light = match (own_nm, &s.spectrum) {
             (Some(nm), _) => Light::at_nm(nm),
             (None, Some(sp)) => Light::at_nm(sp.sample(rng.uniform())),
@@ -547,6 +558,7 @@ impl Sources {
             medium: s.medium,
             source: i,
             light,
+            pol,
         }
     }
 

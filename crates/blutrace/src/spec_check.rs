@@ -82,6 +82,20 @@ impl Ctx<'_> {
         self.bounded(field, p, MAX_ANGLE_DEG, " degrees")
     }
 
+    /// One angle (degrees): finite and within ±[`MAX_ANGLE_DEG`].
+    pub fn angle_deg(&self, field: &str, deg: f64) -> Result<f64> {
+        if self.finite(field, deg)?.abs() > MAX_ANGLE_DEG {
+            return Err(self.err(
+                field,
+                format!(
+                    "must be within ±{MAX_ANGLE_DEG:e} degrees (a thousand turns and more is a typing mistake), got {}",
+                    short(deg)
+                ),
+            ));
+        }
+        Ok(deg)
+    }
+
     /// Three finite numbers within `±max` (`unit` after the bound in the message).
     fn bounded(&self, field: &str, p: [f64; 3], max: f64, unit: &str) -> Result<DVec3> {
         for (i, c) in p.iter().enumerate() {

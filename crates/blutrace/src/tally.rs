@@ -303,6 +303,9 @@ pub struct Ledger {
     /// Weight absorbed per source, by its lamp body.
     #[serde(default)]
     pub absorbed_by_source: Vec<ExactSum>,
+    /// Weight the detector's analyzer absorbed (`[detector] analyzer_deg`; zero without).
+    #[serde(default)]
+    pub absorbed_by_analyzer: ExactSum,
     /// Weight that left the scene.
     pub escaped: ExactSum,
     /// Weight stopped by the bounce cap.
@@ -449,6 +452,7 @@ impl Ledger {
                 weight(a, *b)?;
             }
         }
+        weight(&mut self.absorbed_by_analyzer, o.absorbed_by_analyzer)?;
         weight(&mut self.escaped, o.escaped)?;
         weight(&mut self.killed, o.killed)?;
         count(&mut self.killed_photons, o.killed_photons)?;
@@ -457,7 +461,14 @@ impl Ledger {
 
     /// [`Ledger::accounted`], or `None` past the `i128` range (a damaged file's ledger).
     pub fn checked_accounted(&self) -> Option<ExactSum> {
-        [self.detected.sum, self.escaped, self.killed, self.roulette]
+        let sinks = [
+            self.detected.sum,
+            self.absorbed_by_analyzer,
+            self.escaped,
+            self.killed,
+            self.roulette,
+        ];
+        sinks
             .iter()
             .chain(&self.absorbed_by_surface)
             .chain(&self.absorbed_in_medium)
@@ -696,11 +707,16 @@ impl Tally {
 
 /// Whether a Stokes grid could not come from a run of `photons` photons: a bin whose
 /// squares sum is negative, whose sum exceeds what its squares allow (`sum^2 <= hits *
-/// sumsq`, Cauchy-Schwarz), or that holds more photons than were emitted.
+/// sumsq`, Cauchy-Schwarz, up to the rounding of each term to the sums' grid: a nearly
+/// unpolarized photon's `S1 w` of 1e-12 adds its value to the sum but its square, below
+/// the grid, nothing to the squares), or that holds more photons than were emitted.
 fn bad_stokes(g: &Grid, photons: u64) -> bool {
     g.bins.iter().any(|b| {
-        let (sum, sumsq) = (b.sum.value(), b.sumsq.value());
-        b.sumsq.0 < 0 || b.hits > photons || sum * sum > 1.000001 * sumsq * b.hits as f64
+        let hits = b.hits as f64;
+        let grid = hits * 2f64.powi(-FRACTION_BITS);
+        let sum = (b.sum.value().abs() - grid).max(0.0);
+        let sumsq = b.sumsq.value() + grid;
+        b.sumsq.0 < 0 || b.hits > photons || sum * sum > 1.000001 * sumsq * hits
     })
 }
 

@@ -208,12 +208,15 @@ impl<'a> Tracer<'a> {
                 Flight::Reached => {}
             }
             if let Some((_, ab)) = detected {
+                if let Some(pol) = p.pol {
+                    let passed = scene.detector.analyzer_transmittance(&pol, true_ray.dir);
+                    p.reweigh(passed, &mut out.ledger.absorbed_by_analyzer);
+                    out.stokes
+                        .push(scene.detector.stokes_of(&pol, true_ray.dir));
+                }
                 let weight = p.light.detected(p.weight);
                 out.detections
                     .push(detection(scene, ab, true_ray.dir, weight, p.light));
-                if let Some(pol) = &p.pol {
-                    out.stokes.push(scene.detector.stokes_of(pol, true_ray.dir));
-                }
                 self.count_in_cones(p, (ab, true_ray.dir), weight, out);
                 return Fate::Detected;
             }
@@ -565,9 +568,13 @@ fn absorb_clear(
     }
 }
 
-/// The state a photon leaves its source `e.source` in: the source's, in the frame of its
-/// u axis made perpendicular to the photon's direction, or unpolarized.
+/// The state a photon leaves its source `e.source` in: its own (a ray file's ray's), else
+/// the source's, in the frame of its u axis made perpendicular to the photon's direction,
+/// or unpolarized.
 fn emitted_polarization(scene: &Scene, e: &crate::sources::Emission) -> Polarization {
+    if let Some(pol) = e.pol {
+        return pol;
+    }
     let d = e.ray.dir;
     let source = &scene.sources.list[e.source];
     let frame = source.emitter.u_axis();

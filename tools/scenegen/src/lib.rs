@@ -62,6 +62,7 @@ pub fn all_files() -> Vec<GenFile> {
     files.extend(scenes::prism_plate::files());
     files.extend(scenes::prism_plate::files_meshed());
     files.extend(scenes::bef_stack::files());
+    files.extend(scenes::bef_stack_dbef::files());
     files.extend(scenes::diffusion_lgp::files());
     files.extend(scenes::bench_box::files());
     files

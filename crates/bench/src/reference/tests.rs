@@ -57,8 +57,12 @@ fn refuses_other_scenes_saying_why() {
         ("edge-holder", "more than one part"),
         ("direct-lit", "scatters"),
         ("test/slab", "no dotted face"),
+        ("bench-box", "traces polarization"),
     ] {
-        let s = Scene::load(&dir.join(scene).join("scene.toml")).unwrap();
+        let mut s = Scene::load(&dir.join(scene).join("scene.toml")).unwrap();
+        // Each refused for its shape (polarization, on by default, is refused first),
+        // and bench-box, whose kernel averages s and p, for polarization.
+        s.polarized = scene == "bench-box";
         let e = Reference::new(&s).err().expect("refused").to_string();
         assert!(
             e.contains("box-guide scenes") && e.contains(why),

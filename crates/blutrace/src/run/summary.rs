@@ -146,6 +146,8 @@ pub struct LedgerSummary {
     pub absorbed_by_source_w: BTreeMap<String, f64>,
     /// Power on the target per source, in source order (it adds up to `detected_w`).
     pub detected_by_source_w: Vec<SourceDetected>,
+    /// Power the detector's analyzer absorbed (`[detector] analyzer_deg`; 0 without).
+    pub absorbed_by_analyzer_w: f64,
     /// Power that left the scene.
     pub escaped_w: f64,
     /// Power stopped by the bounce cap.
@@ -259,6 +261,7 @@ impl RunResult {
                         stderr_w: b.mean_and_stderr(l.photons).1 * self.scene.sources.total_power(),
                     })
                     .collect(),
+                absorbed_by_analyzer_w: l.absorbed_by_analyzer.value() * w,
                 escaped_w: l.escaped.value() * w,
                 killed_w: l.killed.value() * w,
                 killed_photons: l.killed_photons,

@@ -585,25 +585,32 @@ fn unpolarized_sources(file: &SceneFile) -> Vec<String> {
         .collect()
 }
 
-/// Whether the scene traces polarization: `[trace] polarization`, else whether a surface
-/// is a polarizer (which needs it: `false` with one is an error) or a source polarized.
+/// Whether the scene traces polarization: `[trace] polarization`, else whether its result
+/// depends on it: a surface with a partial Fresnel event (a dielectric-like model: an
+/// interface), a polarizer or an analyzer (which need it: `false` with one is an error), or
+/// a polarized source.
 fn traces_polarization(
     ctx: &Ctx,
     file: &SceneFile,
     (surfaces, backs): (&[SurfaceModel], &[Option<SurfaceModel>]),
     sources: &Sources,
 ) -> Result<bool> {
-    let all = surfaces.iter().chain(backs.iter().flatten());
-    let polarizer = all
-        .into_iter()
-        .any(|m| matches!(m, SurfaceModel::Polarizer(_)));
-    let polarized_source = sources.list.iter().any(|s| s.polarization.is_some());
+    let all = || surfaces.iter().chain(backs.iter().flatten());
+    let polarizer = all().any(|m| matches!(m, SurfaceModel::Polarizer(_)));
+    let fresnel = all().any(|m| m.interface().is_some());
+    let analyzer = file.detector.analyzer_deg.is_some();
+    let polarized_source =
+        (sources.list.iter()).any(|s| s.polarization.is_some() || s.emitter.polarized());
     match file.trace.polarization {
         Some(false) if polarizer => Err(ctx.err(
             "trace.polarization",
             "is false, but a surface is a polarizer, which needs polarization traced",
         )),
+        Some(false) if analyzer => Err(ctx.err(
+            "trace.polarization",
+            "is false, but detector.analyzer_deg is set: an analyzer needs polarization traced",
+        )),
         Some(on) => Ok(on),
-        None => Ok(polarizer || polarized_source),
+        None => Ok(polarizer || analyzer || fresnel || polarized_source),
     }
 }

@@ -66,18 +66,7 @@ impl SourcePolarizationSpec {
     pub fn build(&self, ctx: &Ctx, field: &str) -> Result<Stokes> {
         match *self {
             SourcePolarizationSpec::Linear { linear_deg } => {
-                let at = format!("{field}.linear_deg");
-                let deg = ctx.finite(&at, linear_deg)?;
-                let max = crate::spec_check::MAX_ANGLE_DEG;
-                if deg.abs() > max {
-                    return Err(ctx.err(
-                        &at,
-                        format!(
-                            "must be within ±{max:e} degrees (a thousand turns and more is a typing mistake), got {}",
-                            crate::spec_check::short(deg)
-                        ),
-                    ));
-                }
+                let deg = ctx.angle_deg(&format!("{field}.linear_deg"), linear_deg)?;
                 Ok(Stokes::linear_deg(deg))
             }
             SourcePolarizationSpec::Stokes { stokes } => {

@@ -43,10 +43,12 @@
 //! table index per ray 2 (a u16: at most [`MAX_TABLES`] tables).
 
 mod emitter;
+pub mod stokes;
 pub mod text;
 pub mod tm25;
 
 pub use emitter::{Alias, RayFileEmitter, RayFileSummary};
+pub use stokes::RayStokes;
 
 use super::array::ArraySpec;
 use super::body::BodySpec;
@@ -54,9 +56,9 @@ use super::spectrum::{EmissionSpectrum, SpectrumSpec, VISIBLE_NM};
 use crate::color::Spectrum;
 use crate::input_file::MAX_INPUT_BYTES;
 use crate::optics::medium::air;
-use crate::scene::geometry_file::{Units, affine_matrix, rotation_deg};
 use crate::sources::MAX_TOTAL_POWER_W;
 use crate::spec_check::{Ctx, short};
+use crate::transform::{Units, affine_matrix, rotation_deg};
 use anyhow::{Result, bail};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
@@ -177,6 +179,9 @@ pub struct RaySet {
     /// The rays' spectral tables (0-based positions in [`FileSpectrum::Tables`]) when the
     /// set has several, else empty.
     pub table: Vec<u16>,
+    /// The rays' polarization when the file gives it (TM-25's Stokes columns, see
+    /// [`stokes`]), else empty.
+    pub stokes: Vec<RayStokes>,
     /// What the file says of wavelengths.
     pub spectrum: FileSpectrum,
     /// The flux's unit.

@@ -84,6 +84,12 @@ fn stokes_bins_no_run_could_score_are_refused() {
     let mut edited = g.clone();
     edited.bins[0].sum.add(1.0); // |sum| beyond what its squares allow
     assert!(bad_stokes(&edited, 2));
+    // Terms below the grid's resolution squared: their squares add nothing, yet a run
+    // scores them (nearly unpolarized light), so they are no damage.
+    let mut faint = Grid::new(1, 1);
+    (0..3).for_each(|_| faint.add(0, 0, 1e-12));
+    assert_eq!(faint.bins[0].sumsq.0, 0);
+    assert!(!bad_stokes(&faint, 3));
     let mut negative = g.clone();
     negative.bins[1].sumsq.0 = -1;
     assert!(bad_stokes(&negative, 2));

@@ -23,7 +23,8 @@
 //!    does not, but one reflected by a guide's two opposite edges does);
 //! 4. it scores `w p T (out.N) Omega n_d^2 / (n^2 |dir.N|)` into the bin it crosses: the
 //!    photon's weight before the event, the model's density towards `dir` (per sr,
-//!    albedo included), the path's throughput, and the Jacobian from `dir` to `out`
+//!    albedo included), the path's throughput (polarized where the run traces
+//!    polarization, through the detector's analyzer when it has one), and the Jacobian from `dir` to `out`
 //!    (radiance over n^2 is kept along specular paths), in the cone count's units
 //!    (`Omega` the cone's solid angle, the pdf's inverse).
 //!
@@ -273,8 +274,14 @@ impl Tracer<'_> {
             if let Some((_, ab)) = detected {
                 p.covered = true;
                 p.left_with = self.invariant(0, out, p.light);
-                let along = self.peeled(&p, true_ray.dir);
-                return along.then(|| (scene.detector.flux_index(ab) as u32, p.weight));
+                if !self.peeled(&p, true_ray.dir) {
+                    return None;
+                }
+                // The panel's rear polarizer, when the detector has one, as photons meet it.
+                let passed = p.pol.map_or(1.0, |pol| {
+                    scene.detector.analyzer_transmittance(&pol, true_ray.dir)
+                });
+                return Some((scene.detector.flux_index(ab) as u32, p.weight * passed));
             }
             let Hit { surf, struck } = surf?;
             let model = self.model(struck, true_ray.dir, surf.normal);

@@ -142,7 +142,10 @@ Geometry: bench-box.obj (tags are its usemtl names), {triangles} triangles.
             lambert("reflector_sheet", SHEET_ALBEDO),
             strip.toml(),
             detector.toml(),
-            trace_table(PHOTONS, 100_000),
+            trace_table(PHOTONS, 100_000)
+                + "# The averaged Fresnel, as the reference kernel (crates/bench) traces: its\n\
+                   # speed and agreement tables compare like with like.\n\
+                   polarization = false\n",
         ],
     )
 }

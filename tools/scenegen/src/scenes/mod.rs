@@ -2,6 +2,7 @@
 //! [`crate::Part`]s and `files()`, the generated files.
 
 pub mod bef_stack;
+pub mod bef_stack_dbef;
 pub mod bench_box;
 pub mod cad_reflector;
 pub mod diffusion_lgp;

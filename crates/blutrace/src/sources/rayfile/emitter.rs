@@ -3,6 +3,7 @@
 
 use super::{FileSpectrum, RaySet};
 use crate::geometry::Ray;
+use crate::optics::polarization::Polarization;
 use crate::rng::PhotonRng;
 use crate::sources::body_shape::{BodyShape, Rect};
 use crate::sources::led::{FlatLed, LedProfile};
@@ -128,6 +129,16 @@ impl RayFileEmitter {
     /// the file gives one per ray (with spectral tables per ray, one more uniform draws it
     /// from the ray's table, as the source's spectrum draws a table's for all rays).
     pub fn emit(&self, rng: &mut PhotonRng) -> (Ray, DVec3, Option<f64>) {
+        let (ray, normal, nm, _) = self.emit_polarized(rng);
+        (ray, normal, nm)
+    }
+
+    /// [`RayFileEmitter::emit`], with the ray's polarization when the file gives it
+    /// ([`super::stokes`]).
+    pub fn emit_polarized(
+        &self,
+        rng: &mut PhotonRng,
+    ) -> (Ray, DVec3, Option<f64>, Option<Polarization>) {
         let i = self.alias.sample(rng.uniform());
         let r = &self.set.rays[i];
         let p = self.shift + self.rot * (DVec3::from_array(r.pos.map(f64::from)) * self.scale);
@@ -140,7 +151,8 @@ impl RayFileEmitter {
             }
             FileSpectrum::None | FileSpectrum::Table(_) => None,
         };
-        (Ray::new(p, d), self.front.normal, nm)
+        let pol = self.set.stokes.get(i).map(|s| s.polarization(self.rot, d));
+        (Ray::new(p, d), self.front.normal, nm, pol)
     }
 
     /// The probability that a photon starts from ray `i`.

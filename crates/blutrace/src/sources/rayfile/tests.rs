@@ -22,6 +22,7 @@ fn sample_set() -> RaySet {
         table: Vec::new(),
         spectrum: FileSpectrum::PerRay,
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     }
 }
@@ -294,6 +295,7 @@ fn tables_set() -> RaySet {
         table: vec![1, 0, 1, 0],
         spectrum: FileSpectrum::Tables(tables),
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     }
 }

@@ -81,6 +81,7 @@ pub fn read_rows(mut reader: impl BufRead, shown: &str, max_rays: usize) -> Resu
         nm,
         table: Vec::new(),
         unit: FluxUnit::Watt,
+        stokes: Vec::new(),
         header_flux: [f64::NAN; 2],
     })
 }

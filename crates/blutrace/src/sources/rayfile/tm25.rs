@@ -27,7 +27,7 @@
 //! | 36288 | | spectral tables (4.7.4), numbered 1, 2, ... in file order: each an i32 count, then (f32 nm, f32 value) pairs; the block is zero-padded to a multiple of 32 bytes |
 //! | | 512 each | names of the additional ray items, UTF-32 (4.7.5) |
 //! | | | additional text, UTF-32 (4.7.6) |
-//! | | | ray records: f32 columns x y z kx ky kz, then radiant flux, wavelength, luminous flux, Stokes S1 S2 S3 and the polarisation ellipse's x y z, tristimulus X Z, spectrum index (a whole number 1..tables, as f32), additional items, each only when its flag is set |
+//! | | | ray records: f32 columns x y z kx ky kz, then radiant flux, wavelength, luminous flux, Stokes S1 S2 S3 and the polarisation ellipse's x y z, tristimulus X Z, spectrum index (a whole number 1..tables, as f32), additional items, each only when its flag is set; the Stokes columns as [`super::stokes`] reads them |
 //!
 //! Spectral tables per ray (identifier 4), as the reference implementation reads them
 //! (TM25RaySetTools `TM25Library/TM25_impl.h`, `ReadHeader`, and `TM25.h`): the tables
@@ -48,6 +48,7 @@
 //! error naming both lengths). Rays are read in one pass, in chunks, straight into the
 //! compact [`RaySet`]; the file is never held whole in memory.
 
+use super::stokes::{RayStokes, STOKES_COLUMNS};
 use super::{
     FileSpectrum, FluxUnit, MAX_TABLES, RaySet, StoredRay, TEXT_FIELDS, check_ray, checked_len,
     table_spectrum,
@@ -122,7 +123,14 @@ impl Header {
     /// fluxes, wavelength, Stokes and tristimulus columns.
     fn index_column(&self) -> u64 {
         let f = |k: usize| self.flags[k] as u64;
-        6 + f(2) + f(3) + f(4) + 6 * f(5) + 2 * f(6)
+        self.stokes_column() + 6 * f(5) + 2 * f(6)
+    }
+
+    /// The first Stokes column (when its flag is set): after the position, direction,
+    /// fluxes and wavelength.
+    fn stokes_column(&self) -> u64 {
+        let f = |k: usize| self.flags[k] as u64;
+        6 + f(2) + f(3) + f(4)
     }
 }
 
@@ -403,12 +411,13 @@ pub fn read(path: &Path) -> Result<RaySet> {
         4 => FileSpectrum::Tables(tables),
         _ => FileSpectrum::None,
     };
-    let (rays, nm, table) = read_rays(path, &mut c, &h)?;
+    let (rays, nm, table, stokes) = read_rays(path, &mut c, &h)?;
     Ok(RaySet {
         text,
         rays,
         nm,
         table,
+        stokes,
         spectrum,
         unit: if h.flags[2] {
             FluxUnit::Watt
@@ -475,12 +484,9 @@ fn read_tables<R: Read>(path: &Path, c: &mut Cursor<R>, h: &Header) -> Result<Ve
 
 /// The ray records, in chunks: positions, unit directions, flux, wavelengths (identifier
 /// 2) and spectrum indices (4, stored 0-based) checked.
-fn read_rays<R: Read>(
-    path: &Path,
-    c: &mut Cursor<R>,
-    h: &Header,
-) -> Result<(Vec<StoredRay>, Vec<f32>, Vec<u16>)> {
+fn read_rays<R: Read>(path: &Path, c: &mut Cursor<R>, h: &Header) -> Result<RayColumns> {
     let per_ray_nm = h.identifier == 2;
+    let stokes_col = h.flags[5].then(|| h.stokes_column() as usize);
     let index_col = (h.identifier == 4).then(|| h.index_column() as usize);
     let cols = h.columns() as usize;
     let flux_col = if h.flags[2] {
@@ -492,6 +498,7 @@ fn read_rays<R: Read>(
     let mut rays = Vec::with_capacity(n);
     let mut nm = Vec::with_capacity(if per_ray_nm { n } else { 0 });
     let mut table = Vec::with_capacity(if index_col.is_some() { n } else { 0 });
+    let mut stokes = Vec::with_capacity(if stokes_col.is_some() { n } else { 0 });
     let mut done = 0;
     while done < n {
         let k = (n - done).min(CHUNK_RAYS);
@@ -517,6 +524,14 @@ fn read_rays<R: Read>(
                     bad(path, at(byte), &format!("ray {} {name}", done + j), msg)
                 },
             )?;
+            if let Some(col) = stokes_col {
+                let cols = std::array::from_fn(|k| v(col + k));
+                let s = RayStokes::read(cols, ray.dir, ray.flux).map_err(|(k, msg)| {
+                    let field = format!("ray {} {} (4.7.2.6)", done + j, STOKES_COLUMNS[k]);
+                    bad(path, at(col + k), &field, msg)
+                })?;
+                stokes.push(s);
+            }
             rays.push(ray);
             if let Some(w) = wl {
                 nm.push(w);
@@ -530,8 +545,12 @@ fn read_rays<R: Read>(
         }
         done += k;
     }
-    Ok((rays, nm, table))
+    Ok((rays, nm, table, stokes))
 }
+
+/// The rays of a file and their optional columns: wavelengths, spectral tables, Stokes
+/// vectors (each empty when the file has none).
+type RayColumns = (Vec<StoredRay>, Vec<f32>, Vec<u16>, Vec<RayStokes>);
 
 /// A ray's spectrum index: a whole number 1..=`tables` stored as an f32 (TM-25-13 numbers
 /// the spectral tables from 1), as the 0-based table.
@@ -588,6 +607,11 @@ pub fn write(path: &Path, set: &RaySet) -> Result<()> {
         if per_ray {
             w.write_all(&set.nm[i].to_le_bytes())?;
         }
+        if let Some(s) = set.stokes.get(i) {
+            for x in s.columns(r.flux) {
+                w.write_all(&x.to_le_bytes())?;
+            }
+        }
         if indexed {
             w.write_all(&((set.table[i] as u32 + 1) as f32).to_le_bytes())?;
         }
@@ -598,6 +622,13 @@ pub fn write(path: &Path, set: &RaySet) -> Result<()> {
 
 /// Why `set` cannot be written as it is, if it cannot.
 fn check_writable(set: &RaySet) -> Result<()> {
+    if !set.stokes.is_empty() && set.stokes.len() != set.rays.len() {
+        bail!(
+            "{} rays but {} Stokes vectors",
+            set.rays.len(),
+            set.stokes.len()
+        );
+    }
     match &set.spectrum {
         FileSpectrum::PerRay if set.unit == FluxUnit::Lumen => {
             bail!("a wavelength per ray needs radiant flux (TM-25-13 4.7.2.5)")
@@ -659,7 +690,8 @@ fn header_bytes(set: &RaySet) -> Result<Vec<u8>> {
     let watt = set.unit == FluxUnit::Watt;
     let per_ray = matches!(set.spectrum, FileSpectrum::PerRay);
     let indexed = matches!(set.spectrum, FileSpectrum::Tables(_));
-    for f in [true, true, watt, per_ray, !watt, false, false, indexed] {
+    let stokes = !set.stokes.is_empty();
+    for f in [true, true, watt, per_ray, !watt, stokes, false, indexed] {
         b.extend((f as i32).to_le_bytes());
     }
     for (k, t) in set.text.iter().enumerate() {

@@ -3,7 +3,9 @@
 //! docstrings and type stubs (`__init__.pyi`) are the user's reference.
 //!
 //! - `scene`: `Scene` (load, key paths, check, trace, optimize, characterise);
-//! - `run`: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
+//! - `run`: `Run` (numpy maps and their bin centres, summary, write, pickling) and `merge`;
+//! - `maps`: a run's maps, computed by the library or read from an output folder;
+//! - `saved`: runs pickled whole, and read back from output folders (`Run.load`);
 //! - `optimization`: `Optimization`, the outcome of `Scene.optimize`;
 //! - `characterisation`: `Characterisation`, a part as a BSDF table (`Scene.characterise`);
 //! - `detached`: long work on a thread of its own, with the GIL released, Ctrl-C
@@ -13,9 +15,11 @@
 mod characterisation;
 mod convert;
 mod detached;
+mod maps;
 mod optimization;
 mod progress;
 mod run;
+mod saved;
 mod scene;
 
 use pyo3::create_exception;

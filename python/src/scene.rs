@@ -35,7 +35,7 @@ pub const BACKENDS: &[(&str, BackendChoice)] = &[
 ];
 
 /// Spellings of the target metrics.
-const TARGET_METRICS: &[(&str, TargetMetric)] = &[
+pub const TARGET_METRICS: &[(&str, TargetMetric)] = &[
     ("mean", TargetMetric::Mean),
     ("efficiency", TargetMetric::Efficiency),
     ("cv", TargetMetric::Cv),
@@ -74,7 +74,7 @@ fn scene_file(p: &Path) -> PathBuf {
 impl Scene {
     /// Load and validate a scene: a scene file or a folder holding `scene.toml`.
     #[staticmethod]
-    fn load(
+    pub fn load(
         py: Python<'_>,
         #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
     ) -> PyResult<Scene> {
@@ -278,7 +278,7 @@ impl Scene {
         );
         // An interrupt or error of the trace outranks one of the progress display.
         let closed = progress::close(py, &reporter, done.load(Ordering::Relaxed));
-        let run = Run::new(traced?.map_err(run_error)?);
+        let run = Run::new(traced?.map_err(run_error)?)?;
         closed?;
         Ok(run)
     }
@@ -294,18 +294,95 @@ impl Scene {
     /// line per iteration on stderr) or a callable taking each iteration's record (a dict).
     /// Ctrl-C stops the search: it returns the outcome of the designs traced before it, with
     /// ``interrupted`` True (before the first design, ``KeyboardInterrupt`` is raised).
-    #[pyo3(signature = (method=None, vary=None, **options))]
-    fn optimize(
+    #[pyo3(signature = (method=None, vary=None, *, photons=None, seed=None, max_iter=None, target_cv=None, objective=None, grid_points=None, degree=None, min_density=None, max_density=None, tag=None, initial_step=None, simplex_tol=None, alpha=None, smoothing=None, dims=None, cells=None, strips=None, edge_margin_mm=None, verify_photons=None, verify_seed=None, threads=None, estimator=None, backend=None, export_placement=None, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn optimize<'py>(
         &self,
-        py: Python<'_>,
-        method: Option<&Bound<'_, PyAny>>,
-        vary: Option<&Bound<'_, PyAny>>,
-        options: Option<&Bound<'_, PyDict>>,
+        py: Python<'py>,
+        method: Option<&Bound<'py, PyAny>>,
+        vary: Option<&Bound<'py, PyAny>>,
+        photons: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
+        max_iter: Option<&Bound<'py, PyAny>>,
+        target_cv: Option<&Bound<'py, PyAny>>,
+        objective: Option<&Bound<'py, PyAny>>,
+        grid_points: Option<&Bound<'py, PyAny>>,
+        degree: Option<&Bound<'py, PyAny>>,
+        min_density: Option<&Bound<'py, PyAny>>,
+        max_density: Option<&Bound<'py, PyAny>>,
+        tag: Option<&Bound<'py, PyAny>>,
+        initial_step: Option<&Bound<'py, PyAny>>,
+        simplex_tol: Option<&Bound<'py, PyAny>>,
+        alpha: Option<&Bound<'py, PyAny>>,
+        smoothing: Option<&Bound<'py, PyAny>>,
+        dims: Option<&Bound<'py, PyAny>>,
+        cells: Option<&Bound<'py, PyAny>>,
+        strips: Option<&Bound<'py, PyAny>>,
+        edge_margin_mm: Option<&Bound<'py, PyAny>>,
+        verify_photons: Option<&Bound<'py, PyAny>>,
+        verify_seed: Option<&Bound<'py, PyAny>>,
+        threads: Option<&Bound<'py, PyAny>>,
+        estimator: Option<&Bound<'py, PyAny>>,
+        backend: Option<&Bound<'py, PyAny>>,
+        export_placement: Option<&Bound<'py, PyAny>>,
+        progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Optimization> {
         let method: Option<String> = method.map(|m| arg(m, "method")).transpose()?;
         let vary: Option<Bound<'_, PyDict>> = vary.map(|v| arg(v, "vary")).transpose()?;
         let (method, vary) = (method.as_deref(), vary.as_ref());
-        optimization::optimize_scene(py, &self.inner, method, vary, options)
+        // The options given, by name: those left out keep the method's defaults.
+        let given = PyDict::new(py);
+        for (name, value) in [
+            ("photons", photons),
+            ("seed", seed),
+            ("max_iter", max_iter),
+            ("target_cv", target_cv),
+            ("objective", objective),
+            ("grid_points", grid_points),
+            ("degree", degree),
+            ("min_density", min_density),
+            ("max_density", max_density),
+            ("tag", tag),
+            ("initial_step", initial_step),
+            ("simplex_tol", simplex_tol),
+            ("alpha", alpha),
+            ("smoothing", smoothing),
+            ("dims", dims),
+            ("cells", cells),
+            ("strips", strips),
+            ("edge_margin_mm", edge_margin_mm),
+            ("verify_photons", verify_photons),
+            ("verify_seed", verify_seed),
+            ("threads", threads),
+            ("estimator", estimator),
+            ("backend", backend),
+            ("export_placement", export_placement),
+            ("progress", progress),
+        ] {
+            if let Some(v) = value {
+                given.set_item(name, v)?;
+            }
+        }
+        optimization::optimize_scene(py, &self.inner, method, vary, Some(&given))
+    }
+
+    /// Scenes are equal when their scene files (with any `set` applied) and every file
+    /// they name are: `scene == scene.copy()`, and a scene differs once `set` changes it.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        match other.cast::<Scene>() {
+            Ok(o) => {
+                let o = &o.borrow().inner;
+                self.inner.source() == o.source()
+                    && self.inner.content_hash() == o.content_hash()
+                    && self.inner.path == o.path
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let study = slf.py().import("blutrace._study")?;
+        study.call_method1("scene_html", (slf,))
     }
 
     /// Characterise a part of the scene into an IS BSDF table, as ``blutrace bsdf`` does:

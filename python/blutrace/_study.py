@@ -124,7 +124,7 @@ def metrics(summary: Mapping[str, Any]) -> dict[str, float]:
 
 def _designs(vary: Mapping[str, Iterable], zipped: bool) -> tuple[list[str], list[tuple]]:
     if not isinstance(vary, Mapping) or not vary:
-        raise TypeError("vary must be a non-empty dict {key path: values}")
+        raise TypeError(f"vary must be a non-empty dict {{key path: values}}, got {vary!r}")
     keys = [str(k) for k in vary]
     values = []
     for k, v in vary.items():
@@ -167,6 +167,10 @@ def sweep(scene, vary, photons=None, seed=None, executor=None, zipped=False, thr
     rows keep the designs' order. Needs pandas (``pip install 'blutrace[study]'``).
     """
     pd = _need("pandas", "blutrace.sweep")
+    from ._native import Scene
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a blutrace.Scene, got {type(scene).__name__}")
     keys, designs = _designs(vary, zipped)
     args = [(scene, keys, d, photons, seed, threads) for d in designs]
     if executor is None:

@@ -3,7 +3,7 @@
 //! runs `merge` into one, and `Run.load` reads an output folder back.
 
 use crate::BlutraceError;
-use crate::convert::{grid, json_to_py, run_error};
+use crate::convert::{grid, json_to_py, run_error, to_json};
 use crate::detached::detached;
 use crate::maps::Maps;
 use crate::saved;
@@ -48,8 +48,8 @@ pub struct Run {
 impl Run {
     /// Wrap a result, computing its maps and summary once.
     pub fn new(result: RunResult) -> PyResult<Run> {
-        let summary = json(&result.summary())?;
-        let history = json(&result.history)?;
+        let summary = to_json(&result.summary())?;
+        let history = to_json(&result.history)?;
         Ok(Run {
             maps: Maps::of(&result),
             inner: Some(Arc::new(result)),
@@ -89,11 +89,6 @@ impl Run {
     fn number(&self, key: &str) -> Option<f64> {
         self.summary.get(key).and_then(|v| v.as_f64())
     }
-}
-
-/// A value as JSON (what the CLI writes).
-fn json(v: &impl serde::Serialize) -> PyResult<serde_json::Value> {
-    serde_json::to_value(v).map_err(|e| BlutraceError::new_err(e.to_string()))
 }
 
 /// Value, standard error or hits of a map the run may lack, as numpy (None when absent).

@@ -2,7 +2,7 @@
 //! its state, bit for bit) and read back from output folders (`Run.load`).
 
 use crate::BlutraceError;
-use crate::convert::{choice, run_error};
+use crate::convert::{choice, py_to_json, run_error};
 use crate::detached::detached;
 use crate::maps::{Frame, Maps};
 use crate::run::Run;
@@ -181,48 +181,57 @@ pub fn shard_run(py: Python<'_>, scene: &Scene, path: PathBuf, file: ShardFile) 
 
 /// `Run.load(dir)`: the shard run of `dir/shard.json`, or the run of an output folder.
 pub fn load(py: Python<'_>, dir: PathBuf) -> PyResult<Run> {
+    let failed = |e: anyhow::Error| BlutraceError::new_err(format!("{e:#}"));
     if dir.join(SHARD_FILE).is_file() {
         let path = dir.join(SHARD_FILE);
         let file = detached(py, || shard::read_shard(&path))?.map_err(run_error)?;
         let scene = Scene::load(py, file.scene_file.clone())?;
         return shard_run(py, &scene, path, file);
     }
+    let path = dir.join("summary.json");
+    if !path.is_file() {
+        return Err(BlutraceError::new_err(format!(
+            "{}: no summary.json or {SHARD_FILE}: not a blutrace output folder",
+            dir.display()
+        )));
+    }
+    let text = blutrace::input_file::read_text(&path, "summary file").map_err(failed)?;
+    // Python's parser: every float of the file as the CLI wrote it, bit for bit.
+    let parsed = py
+        .import("json")?
+        .call_method1("loads", (text,))
+        .map_err(|e| {
+            BlutraceError::new_err(format!("{}: not a summary file: {e}", path.display()))
+        })?;
+    let summary = py_to_json(&parsed)?;
+    let frame = frame(&path, &summary).map_err(failed)?;
     let folder = dir.clone();
-    let (maps, summary, history) = detached(py, move || read_folder(&folder))?
-        .map_err(|e| BlutraceError::new_err(format!("{e:#}")))?;
+    let (maps, history) = detached(py, move || {
+        Ok((
+            Maps::read(&folder, frame)?,
+            read_history(&folder.join("convergence.csv"))?,
+        ))
+    })?
+    .map_err(failed)?;
     Ok(Run::loaded(dir, maps, summary, history))
 }
 
-/// The maps, summary and history of an output folder.
-fn read_folder(dir: &Path) -> anyhow::Result<(Maps, serde_json::Value, serde_json::Value)> {
-    use anyhow::Context;
-    let path = dir.join("summary.json");
-    if !path.is_file() {
-        anyhow::bail!(
-            "{}: no summary.json or {SHARD_FILE}: not a blutrace output folder",
-            dir.display()
-        );
-    }
-    let text = blutrace::input_file::read_text(&path, "summary file")?;
-    let summary: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a summary file", path.display()))?;
+/// The bins' places from a summary's `detector` (read from `path`).
+fn frame(path: &Path, summary: &serde_json::Value) -> anyhow::Result<Frame> {
     let d = &summary["detector"];
     let pair = |key: &str| -> anyhow::Result<[f64; 2]> {
         let v: Vec<f64> = serde_json::from_value(d[key].clone())
-            .with_context(|| format!("{}: detector.{key}", path.display()))?;
+            .map_err(|e| anyhow::anyhow!("{}: detector.{key}: {e}", path.display()))?;
         v.try_into()
             .map_err(|_| anyhow::anyhow!("{}: detector.{key}: not two numbers", path.display()))
     };
     let [nx, ny] = pair("bins")?;
     let [nt, np] = pair("angular_bins")?;
-    let frame = Frame {
+    Ok(Frame {
         bins: [nx as usize, ny as usize],
         size_mm: pair("size_mm")?,
         angular_bins: [nt as usize, np as usize],
-    };
-    let maps = Maps::read(dir, frame)?;
-    let history = read_history(&dir.join("convergence.csv"))?;
-    Ok((maps, summary, history))
+    })
 }
 
 /// `convergence.csv` as the rows `Run.history` gives (empty without the file).

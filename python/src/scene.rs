@@ -294,19 +294,19 @@ impl Scene {
     /// line per iteration on stderr) or a callable taking each iteration's record (a dict).
     /// Ctrl-C stops the search: it returns the outcome of the designs traced before it, with
     /// ``interrupted`` True (before the first design, ``KeyboardInterrupt`` is raised).
-    #[pyo3(signature = (method=None, vary=None, *, photons=None, seed=None, max_iter=None, target_cv=None, objective=None, grid_points=None, degree=None, min_density=None, max_density=None, tag=None, initial_step=None, simplex_tol=None, alpha=None, smoothing=None, dims=None, cells=None, strips=None, edge_margin_mm=None, verify_photons=None, verify_seed=None, threads=None, estimator=None, backend=None, export_placement=None, progress=None))]
+    #[pyo3(signature = (method=None, vary=None, *, objective=None, grid_points=None, photons=None, seed=None, max_iter=None, target_cv=None, degree=None, min_density=None, max_density=None, tag=None, initial_step=None, simplex_tol=None, alpha=None, smoothing=None, dims=None, cells=None, strips=None, edge_margin_mm=None, verify_photons=None, verify_seed=None, threads=None, estimator=None, backend=None, export_placement=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn optimize<'py>(
         &self,
         py: Python<'py>,
         method: Option<&Bound<'py, PyAny>>,
         vary: Option<&Bound<'py, PyAny>>,
+        objective: Option<&Bound<'py, PyAny>>,
+        grid_points: Option<&Bound<'py, PyAny>>,
         photons: Option<&Bound<'py, PyAny>>,
         seed: Option<&Bound<'py, PyAny>>,
         max_iter: Option<&Bound<'py, PyAny>>,
         target_cv: Option<&Bound<'py, PyAny>>,
-        objective: Option<&Bound<'py, PyAny>>,
-        grid_points: Option<&Bound<'py, PyAny>>,
         degree: Option<&Bound<'py, PyAny>>,
         min_density: Option<&Bound<'py, PyAny>>,
         max_density: Option<&Bound<'py, PyAny>>,

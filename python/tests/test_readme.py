@@ -4,15 +4,21 @@ from __future__ import annotations
 
 import re
 import subprocess
+
+import pytest
 import sys
 
 from conftest import REPO
 
 
 def test_the_readmes_python_example_runs(tmp_path):
+    pytest.importorskip("pandas")
+    pytest.importorskip("matplotlib")
     readme = (REPO / "README.md").read_text()
     section = readme.split("## From Python", 1)[1]
-    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    # The first block, then the design study that continues it (with its extras).
+    code = blocks[0] + "\nimport matplotlib\nmatplotlib.use('Agg')\n" + blocks[1]
     code = code.replace('"scenes/', f'"{REPO}/scenes/')
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
@@ -21,3 +27,7 @@ def test_the_readmes_python_example_runs(tmp_path):
     assert (tmp_path / "out/py-notebook14/flux.exr").is_file()
     assert (tmp_path / "out/py-notebook14-opt/optimized.toml").is_file()
     assert (tmp_path / "out/sheet.bsdf").read_text().count("DataBegin") == 1
+    # The sweep's DataFrame: a row per design, values with their errors.
+    table = lines[-5:]
+    assert table[0].split() == ["surfaces.lgp_back.ink_albedo", "efficiency", "efficiency_stderr", "cv_debiased"]
+    assert len(table) == 5 and all(float(r.split()[3]) > 0 for r in table[1:])

@@ -295,6 +295,20 @@ def test_sweep_zips_lists_and_runs_on_an_executor(box):
         bt.sweep(box, {KEY: [0.5, 0.6], "trace.seed": [1]}, photons=1000, zipped=True)
 
 
+def test_sweep_arguments_of_a_wrong_kind_are_errors_naming_them(box):
+    pytest.importorskip("pandas")
+    with pytest.raises(TypeError, match="scene must be a blutrace.Scene, got str"):
+        bt.sweep("scenes/bench-box", {KEY: [0.5]})
+    with pytest.raises(TypeError, match="vary must be a non-empty dict"):
+        bt.sweep(box, [KEY, 0.5])
+    with pytest.raises(ValueError, match=r"vary\['surfaces.lgp_back.ink_albedo'\] has no values"):
+        bt.sweep(box, {KEY: []})
+    with pytest.raises(ValueError, match="photons"):
+        bt.sweep(box, {KEY: [0.5]}, photons=0)
+    with pytest.raises(ValueError, match="no key 'nope'"):
+        bt.sweep(box, {"surfaces.lgp_back.nope": [0.5]}, photons=1000)
+
+
 def test_sweep_without_pandas_names_the_extra(box, monkeypatch):
     monkeypatch.setitem(sys.modules, "pandas", None)
     with pytest.raises(ImportError, match=r"pip install 'blutrace\[study\]'"):
@@ -344,3 +358,41 @@ def test_bundled_scenes_come_with_the_installed_package():
     assert "bench-box" in bt.scenes.names() and "test/slab" in bt.scenes.names()
     with pytest.raises(ValueError, match="name: no bundled scene 'nope' .*bench-box"):
         bt.scenes.path("nope")
+
+
+# --- optimizations and characterisations pickle ---------------------------------------------
+
+def files_of(folder: pathlib.Path) -> dict:
+    return {p.relative_to(folder).as_posix(): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_an_optimization_pickles_with_its_reports_and_files(phone, tmp_path):
+    opt = phone.optimize(method="grid", vary={"sources.*.center.2": (0.2, 0.3)}, grid_points=2,
+                         photons=10_000, verify_photons=0, objective="efficiency")
+    with ProcessPoolExecutor(1) as pool:  # a worker process returns it, as pickle carries it
+        back = pool.submit(pickle.loads, pickle.dumps(opt)).result()
+    assert back.summary == opt.summary and back.history == opt.history
+    assert back.interrupted is False and back.scene == opt.scene
+    assert repr(back) == repr(opt)
+    opt.write(tmp_path / "a")
+    written = back.write(tmp_path / "b")
+    assert sorted(pathlib.Path(w).name for w in written) == sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert files_of(tmp_path / "b") == files_of(tmp_path / "a")
+    # Pickled again after unpickling: the same.
+    assert pickle.loads(pickle.dumps(back)).summary == opt.summary
+
+
+def test_a_characterisation_pickles_with_its_table(tmp_path):
+    from test_characterise import OBJ, SHEET
+
+    (tmp_path / "sheet.obj").write_text(OBJ)
+    scene = bt.Scene.from_toml(SHEET, tmp_path / "scene.toml")
+    c = scene.characterise("sheet", photons=5_000, aoi=[0, 60])
+    back = pickle.loads(pickle.dumps(c))
+    assert (back.part, back.aoi, back.rotations) == (c.part, c.aoi, c.rotations)
+    assert back.to_bsdf() == c.to_bsdf() and "DataBegin" in c.to_bsdf()
+    for k, v in c.fates.items():
+        assert np.array_equal(back.fates[k], v), k
+    with pytest.raises(bt.BlutraceError, match="sheet.obj"):  # still spares the scene's files
+        back.write(tmp_path / "sheet.obj")

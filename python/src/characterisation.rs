@@ -181,7 +181,7 @@ pub fn characterise_scene(
     scene: &RustScene,
     args: Args<'_, '_>,
 ) -> PyResult<Characterisation> {
-    crate::scene::tag_arg(scene, args.tag)?;
+    crate::options::tag_arg(scene, args.tag)?;
     let photons = args
         .photons
         .map_or(Ok(1_000_000), |p| count(p, "photons", 1))?;

@@ -4,7 +4,8 @@
 
 use crate::convert::{arg, choice, count, json_to_py, py_to_json, run_error, to_json};
 use crate::detached::{Waited, detached, wait_detached};
-use crate::scene::{BACKENDS, ESTIMATORS, Scene, tag_arg, threads_arg};
+use crate::options::{BACKENDS, ESTIMATORS, tag_arg, threads_arg};
+use crate::scene_value::Scene;
 use blutrace::optics::dots::Placement;
 use blutrace::optimize::ObjectiveSpec;
 use blutrace::optimize::layout::VarySpec;
@@ -219,14 +220,7 @@ impl Optimization {
     /// The inverse of pickling.
     #[staticmethod]
     fn _restore(state: &Bound<'_, PyAny>) -> PyResult<Optimization> {
-        let (scene, summary, history, interrupted, method, files): (
-            Bound<'_, PyAny>,
-            Bound<'_, PyAny>,
-            Bound<'_, PyAny>,
-            bool,
-            String,
-            Vec<(PathBuf, Vec<u8>)>,
-        ) = state.extract()?;
+        let (scene, summary, history, interrupted, method, files): State<'_> = state.extract()?;
         let scene: Scene = scene.cast::<Scene>()?.borrow().clone();
         Ok(Optimization {
             outcome: None,
@@ -248,6 +242,17 @@ impl Optimization {
         )
     }
 }
+
+/// What an optimization pickles as: the optimized scene, summary and history (as Python
+/// objects), interrupted, the method's name and the files `write` writes.
+type State<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    bool,
+    String,
+    Vec<(PathBuf, Vec<u8>)>,
+);
 
 /// The spelling of `m` in [`METHODS`].
 fn name_of_method(m: Method) -> String {

@@ -6,8 +6,8 @@ use crate::BlutraceError;
 use crate::convert::{grid, json_to_py, run_error, to_json};
 use crate::detached::detached;
 use crate::maps::Maps;
-use crate::saved;
-use crate::scene::Scene;
+use crate::saved::{self, Saved};
+use crate::scene_value::{Scene, load_scene};
 use blutrace::run::RunResult;
 use blutrace::run::metrics::Map;
 use blutrace::shard::{self, ShardFile};
@@ -368,7 +368,7 @@ impl Run {
             }),
             None => {
                 let file = self.summary["scene_file"].as_str().unwrap_or_default();
-                Scene::load(py, PathBuf::from(file))
+                load_scene(py, Path::new(file))
             }
         }
     }
@@ -404,7 +404,14 @@ impl Run {
         py: Python<'_>,
         #[pyo3(from_py_with = crate::convert::dir_arg)] dir: PathBuf,
     ) -> PyResult<Run> {
-        saved::load(py, dir)
+        match saved::load(py, &dir)? {
+            Saved::Shard(run) => Run::new(*run),
+            Saved::Outputs {
+                maps,
+                summary,
+                history,
+            } => Ok(Run::loaded(dir, *maps, summary, history)),
+        }
     }
 
     /// An xarray.Dataset of every map with its standard error and hits, coordinates in
@@ -429,7 +436,8 @@ impl Run {
             return PyTuple::new(py, [load, args]);
         };
         if run.options.shard.is_none() {
-            return saved::reduce_whole(py, run);
+            let restore = py.get_type::<Run>().getattr("_from_state")?;
+            return saved::reduce_whole(py, run, restore);
         }
         let file = ShardFile::of(run).map_err(|e| BlutraceError::new_err(e.to_string()))?;
         let json =
@@ -444,13 +452,18 @@ impl Run {
     fn _from_shard(py: Python<'_>, scene: &Scene, json: &str) -> PyResult<Run> {
         let file: ShardFile = serde_json::from_str(json)
             .map_err(|e| PyValueError::new_err(format!("not a blutrace shard: {e}")))?;
-        saved::shard_run(py, scene, PathBuf::from("the pickled shard"), file)
+        Run::new(saved::shard_run(
+            py,
+            scene,
+            PathBuf::from("the pickled shard"),
+            file,
+        )?)
     }
 
     /// A whole run from its scene, tallies and the rest of its state (unpickling).
     #[staticmethod]
     fn _from_state(scene: &Scene, tallies: &str, state: &Bound<'_, PyAny>) -> PyResult<Run> {
-        saved::whole_run(scene, tallies, state)
+        Run::new(saved::whole_run(scene, tallies, state)?)
     }
 
     fn __repr__(&self) -> String {

@@ -5,8 +5,8 @@ use crate::BlutraceError;
 use crate::convert::{choice, py_to_json, run_error};
 use crate::detached::detached;
 use crate::maps::{Frame, Maps};
-use crate::run::Run;
-use crate::scene::{ESTIMATORS, Scene, TARGET_METRICS};
+use crate::options::{ESTIMATORS, TARGET_METRICS};
+use crate::scene_value::{Scene, load_scene};
 use blutrace::run::metrics::{Metric, MetricValues};
 use blutrace::run::{ConvergenceRow, RunOptions, RunResult, StoppedBy};
 use blutrace::shard::{self, SHARD_FILE, ShardFile};
@@ -75,8 +75,13 @@ fn metric_values(v: &[f64]) -> PyResult<MetricValues> {
     Ok(MetricValues::from_fn(|m| v[m as usize]))
 }
 
-/// `__reduce__` of a whole (not shard) run: `Run._from_state(scene, tallies, state)`.
-pub fn reduce_whole<'py>(py: Python<'py>, run: &RunResult) -> PyResult<Bound<'py, PyTuple>> {
+/// `__reduce__` of a whole (not shard) run: `restore(scene, tallies, state)`, `restore`
+/// being `Run._from_state`.
+pub fn reduce_whole<'py>(
+    py: Python<'py>,
+    run: &RunResult,
+    restore: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyTuple>> {
     let tallies = serde_json::to_string(&(&run.tally, &run.groups))
         .map_err(|e| BlutraceError::new_err(e.to_string()))?;
     let o = &run.options;
@@ -107,13 +112,12 @@ pub fn reduce_whole<'py>(py: Python<'py>, run: &RunResult) -> PyResult<Bound<'py
     let scene = Scene {
         inner: run.scene.clone(),
     };
-    let restore = py.get_type::<Run>().getattr("_from_state")?;
     let args = (scene, tallies, state).into_pyobject(py)?.into_any();
     PyTuple::new(py, [restore, args])
 }
 
 /// The inverse of [`reduce_whole`].
-pub fn whole_run(scene: &Scene, tallies: &str, state: &Bound<'_, PyAny>) -> PyResult<Run> {
+pub fn whole_run(scene: &Scene, tallies: &str, state: &Bound<'_, PyAny>) -> PyResult<RunResult> {
     let bad = |what: &str| PyValueError::new_err(format!("not a pickled blutrace run: {what}"));
     let (tally, groups): (Tally, Vec<Tally>) =
         serde_json::from_str(tallies).map_err(|e| bad(&e.to_string()))?;
@@ -160,14 +164,19 @@ pub fn whole_run(scene: &Scene, tallies: &str, state: &Bound<'_, PyAny>) -> PyRe
             .map(|v| metric_values(v))
             .collect::<PyResult<_>>()?,
     };
-    Run::new(result)
+    Ok(result)
 }
 
 /// The shard run of `file` (from `path`), checked against `scene`.
-pub fn shard_run(py: Python<'_>, scene: &Scene, path: PathBuf, file: ShardFile) -> PyResult<Run> {
+pub fn shard_run(
+    py: Python<'_>,
+    scene: &Scene,
+    path: PathBuf,
+    file: ShardFile,
+) -> PyResult<RunResult> {
     let shards = vec![(path, file)];
     let scene = scene.inner.clone();
-    let run = detached(py, || {
+    detached(py, || {
         shard::check(&shards, &scene)?;
         let mut run = shard::merge(&shards, scene.clone())?;
         let f = &shards[0].1;
@@ -175,18 +184,29 @@ pub fn shard_run(py: Python<'_>, scene: &Scene, path: PathBuf, file: ShardFile) 
         run.threads = f.threads;
         Ok(run)
     })?
-    .map_err(run_error)?;
-    Run::new(run)
+    .map_err(run_error)
+}
+
+/// What an output folder holds.
+pub enum Saved {
+    /// A shard run (`shard.json`).
+    Shard(Box<RunResult>),
+    /// The outputs of a run: its maps, summary and history as the files hold them.
+    Outputs {
+        maps: Box<Maps>,
+        summary: serde_json::Value,
+        history: serde_json::Value,
+    },
 }
 
 /// `Run.load(dir)`: the shard run of `dir/shard.json`, or the run of an output folder.
-pub fn load(py: Python<'_>, dir: PathBuf) -> PyResult<Run> {
+pub fn load(py: Python<'_>, dir: &Path) -> PyResult<Saved> {
     let failed = |e: anyhow::Error| BlutraceError::new_err(format!("{e:#}"));
     if dir.join(SHARD_FILE).is_file() {
         let path = dir.join(SHARD_FILE);
         let file = detached(py, || shard::read_shard(&path))?.map_err(run_error)?;
-        let scene = Scene::load(py, file.scene_file.clone())?;
-        return shard_run(py, &scene, path, file);
+        let scene = load_scene(py, &file.scene_file)?;
+        return shard_run(py, &scene, path, file).map(|r| Saved::Shard(Box::new(r)));
     }
     let path = dir.join("summary.json");
     if !path.is_file() {
@@ -205,7 +225,7 @@ pub fn load(py: Python<'_>, dir: PathBuf) -> PyResult<Run> {
         })?;
     let summary = py_to_json(&parsed)?;
     let frame = frame(&path, &summary).map_err(failed)?;
-    let folder = dir.clone();
+    let folder = dir.to_path_buf();
     let (maps, history) = detached(py, move || {
         Ok((
             Maps::read(&folder, frame)?,
@@ -213,7 +233,11 @@ pub fn load(py: Python<'_>, dir: PathBuf) -> PyResult<Run> {
         ))
     })?
     .map_err(failed)?;
-    Ok(Run::loaded(dir, maps, summary, history))
+    Ok(Saved::Outputs {
+        maps: Box::new(maps),
+        summary,
+        history,
+    })
 }
 
 /// The bins' places from a summary's `detector` (read from `path`).

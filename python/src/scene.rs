@@ -7,82 +7,28 @@ use crate::convert::{
 };
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
+use crate::options::{BACKENDS, ESTIMATORS, TARGET_METRICS, threads_arg};
 use crate::progress;
 use crate::run::Run;
-use blutrace::accel::BackendChoice;
-use blutrace::estimator::Estimator;
-use blutrace::run::{self, Interrupt, Progress, RunOptions, Shard, TargetMetric};
+use crate::scene_value::{Scene, load_scene};
+use blutrace::run::{self, Interrupt, Progress, RunOptions, Shard};
 use blutrace::scene::{Scene as RustScene, key_path};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Spellings of the estimators, as on the command line.
-pub const ESTIMATORS: &[(&str, Estimator)] = &[
-    ("analog", Estimator::Analog),
-    ("weighted", Estimator::Weighted),
-];
-
-/// Spellings of the intersection backends.
-pub const BACKENDS: &[(&str, BackendChoice)] = &[
-    ("auto", BackendChoice::Auto),
-    ("embree", BackendChoice::Embree),
-    ("bvh", BackendChoice::Bvh),
-    ("brute", BackendChoice::Brute),
-];
-
-/// Spellings of the target metrics.
-pub const TARGET_METRICS: &[(&str, TargetMetric)] = &[
-    ("mean", TargetMetric::Mean),
-    ("efficiency", TargetMetric::Efficiency),
-    ("cv", TargetMetric::Cv),
-    ("nine-point", TargetMetric::NinePoint),
-    ("thirteen-point", TargetMetric::ThirteenPoint),
-    ("bin", TargetMetric::Bin),
-];
-
-/// A validated, traceable scene: a value (``copy()`` gives an independent one).
-///
-/// ``Scene.load(path)`` reads a scene file, or ``scene.toml`` in a folder, and every file it
-/// names; ``Scene.from_toml(text, path)`` builds one from text (geometry relative to
-/// ``path``'s folder). ``get(key)`` and ``set(key, value)`` read and change the scene file's
-/// values by key path: dotted keys and array indices from 0 (``sources.0.center.2``), ``*``
-/// for every element of an array (``sources.*.center.2``: ``get`` gives their one value, or
-/// the list of their values when they differ); ``set`` takes numbers, str, lists, dicts and
-/// numpy arrays and scalars, and loads the scene again from the edited file, so every
-/// check runs. ``check()`` returns what ``blutrace check --json`` prints.
-#[pyclass(module = "blutrace", name = "Scene")]
-#[derive(Clone)]
-pub struct Scene {
-    /// The scene.
-    pub inner: Arc<RustScene>,
-}
-
-/// The scene file a path names: the path, or `scene.toml` in it when it is a folder.
-fn scene_file(p: &Path) -> PathBuf {
-    if p.is_dir() {
-        p.join("scene.toml")
-    } else {
-        p.to_path_buf()
-    }
-}
 
 #[pymethods]
 impl Scene {
     /// Load and validate a scene: a scene file or a folder holding `scene.toml`.
     #[staticmethod]
-    pub fn load(
+    fn load(
         py: Python<'_>,
         #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
     ) -> PyResult<Scene> {
-        let file = scene_file(&path);
-        let scene = detached(py, || RustScene::load(&file))?.map_err(scene_error)?;
-        Ok(Scene {
-            inner: Arc::new(scene),
-        })
+        load_scene(py, &path)
     }
 
     /// A scene from the text of a scene file; its geometry paths are relative to `path`'s
@@ -486,29 +432,5 @@ fn shard_arg(v: &Bound<'_, PyAny>) -> PyResult<Shard> {
     Ok(Shard {
         index: index as u64,
         count: count as u64,
-    })
-}
-
-/// `threads=n` checked: 1..=MAX_THREADS.
-pub fn threads_arg(t: &Bound<'_, PyAny>) -> PyResult<usize> {
-    let n = count(t, "threads", 1)?;
-    if n > run::MAX_THREADS as u64 {
-        return Err(PyValueError::new_err(format!(
-            "threads must be within 1..={}, got {n}",
-            run::MAX_THREADS
-        )));
-    }
-    Ok(n as usize)
-}
-
-/// Argument `tag` checked: the index of a tag of `scene`, else a `ValueError` listing them
-/// (the same for every call that names a part by its tag).
-pub fn tag_arg(scene: &RustScene, tag: &str) -> PyResult<usize> {
-    scene.tags.iter().position(|t| t == tag).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "tag: no tag '{tag}' in {} (its tags: {})",
-            scene.path.display(),
-            scene.tags.join(", ")
-        ))
     })
 }

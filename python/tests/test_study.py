@@ -396,3 +396,27 @@ def test_a_characterisation_pickles_with_its_table(tmp_path):
         assert np.array_equal(back.fates[k], v), k
     with pytest.raises(bt.BlutraceError, match="sheet.obj"):  # still spares the scene's files
         back.write(tmp_path / "sheet.obj")
+
+
+# --- the package's house ----------------------------------------------------------------------
+
+def test_the_extension_modules_depend_on_each_other_without_a_circle():
+    """python/src: scene -> run -> ... never back to scene (nor run <-> saved,
+    optimization -> scene): each module's `crate::x` uses form an acyclic graph."""
+    import re
+
+    from conftest import REPO
+
+    src = REPO / "python" / "src"
+    deps = {
+        p.stem: set(re.findall(r"crate::([a-z_]+)", p.read_text())) - {p.stem}
+        for p in src.glob("*.rs")
+    }
+    mods = set(deps)
+
+    def reaches(a, b, seen=()):
+        return any(d == b or (d in mods and d not in seen and reaches(d, b, seen + (d,)))
+                   for d in deps[a] & mods)
+
+    circles = sorted(m for m in mods - {"lib"} if reaches(m, m))
+    assert circles == [], {m: sorted(deps[m] & mods) for m in circles}

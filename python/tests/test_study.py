@@ -60,26 +60,23 @@ def test_bin_centres_are_in_mm_and_degrees_in_the_detector_frame(box, run):
     assert run.theta_deg[0] == 2.5 and run.theta_deg[-1] == 87.5
     assert run.phi_deg[0] == 5.0 and run.phi_deg[-1] == 355.0
     # The centres the summary's luminance rows use.
-    lum_rows = [r["theta_deg"] for r in bt.Scene.load(SCENES / "phone-led").trace(
-        photons=20_000, seed=1).summary["luminance"]["by_theta"]]
-    assert np.array_equal(np.asarray(lum_rows), bt.Scene.load(SCENES / "phone-led").trace(
-        photons=1000, seed=1).theta_deg)
+    lit = bt.Scene.load(SCENES / "phone-led").trace(photons=5_000, seed=1)
+    rows = [r["theta_deg"] for r in lit.summary["luminance"]["by_theta"]]
+    assert np.array_equal(np.asarray(rows), lit.theta_deg)
 
 
 # --- the CLI's other outputs -----------------------------------------------------------
 
 def cli_folder(cli, scene: bt.Scene, tmp_path: pathlib.Path, photons: int, seed: int):
-    file = tmp_path / "scene.toml"
-    file.write_text(scene.to_toml())
-    # Geometry paths are relative to the scene file: keep it in the scene's folder.
-    local = pathlib.Path(scene.path).parent / f".py49-{tmp_path.name}.toml"
-    local.write_text(scene.to_toml())
-    try:
-        out = tmp_path / "cli"
-        run_cli(cli, "trace", str(local), "--photons", str(photons), "--seed", str(seed),
-                "--out", str(out), "--quiet")
-    finally:
-        local.unlink()
+    """The CLI's outputs of `scene` (as edited): its folder copied, the file replaced."""
+    import shutil
+
+    copy = tmp_path / "scene"
+    shutil.copytree(pathlib.Path(scene.path).parent, copy)
+    (copy / "scene.toml").write_text(scene.to_toml())
+    out = tmp_path / "cli"
+    run_cli(cli, "trace", str(copy), "--photons", str(photons), "--seed", str(seed),
+            "--out", str(out), "--quiet")
     return out
 
 
@@ -153,6 +150,12 @@ def test_to_xarray_has_every_map_with_errors_coordinates_and_the_summary(polariz
     assert ds.attrs["extraction_efficiency"] == polarized.efficiency[0]
     assert ds.attrs["uniformity_cv"] == polarized.summary["uniformity"]["cv"]
     assert "luminance" not in ds  # no lumens in bench-box
+
+
+def test_to_xarray_without_xarray_names_the_extra(run, monkeypatch):
+    monkeypatch.setitem(sys.modules, "xarray", None)
+    with pytest.raises(ImportError, match=r"Run.to_xarray needs xarray: pip install 'blutrace\[study\]'"):
+        run.to_xarray()
 
 
 def test_to_xarray_of_a_spectral_run_has_colour_and_luminance(color_run):
@@ -324,6 +327,8 @@ def test_scenes_compare_by_content(box, phone):
     assert c != box
     c.set(KEY, box.get(KEY))
     assert c == box
+    with pytest.raises(TypeError, match="unhashable"):  # a value that set() changes
+        hash(c)
 
 
 def test_runs_and_scenes_show_as_html(run, color_run, box):

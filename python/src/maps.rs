@@ -77,7 +77,7 @@ impl Maps {
     }
 
     /// The maps of an output folder, from its images (stored as float32; `frame` from
-    /// its `summary.json`). u' and v' have no standard error there (NaN).
+    /// its `summary.json`).
     pub fn read(dir: &Path, frame: Frame) -> Result<Maps> {
         let flux = Image::read(&dir.join("flux.exr"))?.context("no flux.exr")?;
         let angular = Image::read(&dir.join("angular.exr"))?.context("no angular.exr")?;
@@ -92,8 +92,13 @@ impl Maps {
             ]),
             None => None,
         };
+        // Files written before color.exr held the errors of u', v' have none (NaN).
+        let uv_err = |c: &Image, n: &'static str| if c.has(n) { n } else { "" };
         let uv = match &color {
-            Some(c) => Some([c.map("u_prime", "", "hits")?, c.map("v_prime", "", "hits")?]),
+            Some(c) => Some([
+                c.map("u_prime", uv_err(c, "stderr.u_prime"), "hits")?,
+                c.map("v_prime", uv_err(c, "stderr.v_prime"), "hits")?,
+            ]),
             None => None,
         };
         let stokes = match &stokes {

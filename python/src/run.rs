@@ -265,8 +265,7 @@ impl Run {
         part(py, self.maps.uv.as_ref().map(|m| &m[0]), Part::Value)
     }
 
-    /// Standard error of `u_prime` (jackknife over the run's photon groups; NaN for a
-    /// run read from a folder, whose `color.exr` does not hold it).
+    /// Standard error of `u_prime` (jackknife over the run's photon groups).
     #[getter]
     fn u_prime_stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         part(py, self.maps.uv.as_ref().map(|m| &m[0]), Part::Stderr)

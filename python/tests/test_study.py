@@ -93,6 +93,8 @@ def test_luminance_colour_and_uv_equal_the_command_lines_images(cli, color_scene
         assert np.array_equal(f32(getattr(color_run, f"{name}_stderr")), col[f"stderr.{name}"])
     assert np.array_equal(f32(color_run.u_prime), col["u_prime"], equal_nan=True)
     assert np.array_equal(f32(color_run.v_prime), col["v_prime"], equal_nan=True)
+    assert np.array_equal(f32(color_run.u_prime_stderr), col["stderr.u_prime"], equal_nan=True)
+    assert np.array_equal(f32(color_run.v_prime_stderr), col["stderr.v_prime"], equal_nan=True)
     # Y is the illuminance: its mean is the summary's, in lux.
     lux = color_run.summary["color"]["illuminance_lux"]["value"]
     assert color_run.Y.mean() == pytest.approx(lux, rel=1e-9)
@@ -236,7 +238,8 @@ def test_load_reads_what_write_wrote_with_colour(color_run, tmp_path):
     loaded = bt.Run.load(tmp_path / "out")
     for name in ["luminance", "X", "Y_stderr", "u_prime", "angular_luminance"]:
         assert np.array_equal(getattr(loaded, name), f32(getattr(color_run, name)), equal_nan=True), name
-    assert np.isnan(loaded.u_prime_stderr).all()  # color.exr holds no error of u'
+    for name in ["u_prime_stderr", "v_prime_stderr"]:
+        assert np.array_equal(getattr(loaded, name), f32(getattr(color_run, name))), name
 
 
 def test_load_of_a_folder_without_a_run_names_it(tmp_path):

@@ -79,8 +79,10 @@ impl Maps {
     /// The maps of an output folder, from its images (stored as float32; `frame` from
     /// its `summary.json`).
     pub fn read(dir: &Path, frame: Frame) -> Result<Maps> {
-        let flux = Image::read(&dir.join("flux.exr"))?.context("no flux.exr")?;
-        let angular = Image::read(&dir.join("angular.exr"))?.context("no angular.exr")?;
+        let needed = |name: &str| -> Result<Image> {
+            Image::read(&dir.join(name))?.with_context(|| format!("{}: no {name}", dir.display()))
+        };
+        let (flux, angular) = (needed("flux.exr")?, needed("angular.exr")?);
         let luminance = Image::read(&dir.join("luminance.exr"))?;
         let color = Image::read(&dir.join("color.exr"))?;
         let stokes = Image::read(&dir.join("stokes.exr"))?;

@@ -249,6 +249,23 @@ def test_load_of_a_folder_without_a_run_names_it(tmp_path):
         bt.Run.load(3)
 
 
+def test_a_damaged_output_folder_is_an_error_naming_the_file_and_field(run, tmp_path):
+    out = tmp_path / "out"
+    run.write(out)
+    summary = json.loads((out / "summary.json").read_text())
+    del summary["detector"]["bins"]
+    (out / "summary.json").write_text(json.dumps(summary))
+    with pytest.raises(bt.BlutraceError, match=r"summary.json: detector.bins"):
+        bt.Run.load(out)
+    (out / "summary.json").write_text("{ not json")
+    with pytest.raises(bt.BlutraceError, match=r"summary.json: not a summary file"):
+        bt.Run.load(out)
+    run.write(out)
+    (out / "flux.exr").unlink()
+    with pytest.raises(bt.BlutraceError, match=f"{out}: no flux.exr"):
+        bt.Run.load(out)
+
+
 def test_python_and_cli_shards_merge_either_way(cli, box, tmp_path):
     single = box.trace(photons=N, seed=8)
     py_shard = box.trace(photons=N, seed=8, shard=(0, 2))

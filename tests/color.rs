@@ -168,6 +168,25 @@ fn colour_tallies_do_not_depend_on_threads_and_outputs_are_written() {
     let (y, r) = (channel("Y"), channel("R"));
     assert_eq!(y.len(), 81);
     assert!(y.iter().sum::<f32>() > 0.0 && r.iter().any(|&v| v > 0.0));
+    // u', v' per bin with their jackknife errors: finite and small where light fell.
+    let (u, ue) = (channel("u_prime"), channel("stderr.u_prime"));
+    let ve = channel("stderr.v_prime");
+    let lit: Vec<usize> = (0..81).filter(|&i| y[i] > 0.0).collect();
+    assert!(!lit.is_empty());
+    for &i in &lit {
+        assert!(u[i] > 0.0 && u[i] < 0.7, "u' {} in bin {i}", u[i]);
+    }
+    let mean = |e: &[f32]| lit.iter().map(|&i| e[i]).sum::<f32>() / lit.len() as f32;
+    assert!(
+        mean(&ue) > 0.0 && mean(&ue) < 0.05,
+        "mean u' error {}",
+        mean(&ue)
+    );
+    assert!(
+        mean(&ve) > 0.0 && mean(&ve) < 0.05,
+        "mean v' error {}",
+        mean(&ve)
+    );
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.path().join("run/summary.json")).unwrap())
             .unwrap();

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's tests (python/): a venv under target/ (target/python-venv) with
-# maturin, numpy, pytest and tqdm from PyPI (pinned in python/requirements-test.txt), the
+# maturin, numpy, pytest, tqdm and the optional pandas, xarray and matplotlib (sweeps,
+# to_xarray and the examples' plots; about 10 s of installing on a fresh venv) from PyPI
+# (pinned in python/requirements-test.txt), the
 # package built by maturin (a wheel in target/python-wheels) and installed into it, then
 # pytest on python/tests. tools/test.sh runs this after the Rust tests, unless
 # BLUTRACE_SKIP_PYTHON=1. Nothing is written outside target/ and $TMPDIR.

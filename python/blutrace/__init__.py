@@ -5,6 +5,9 @@
 >>> scene.set("surfaces.lgp_back.ink_albedo", 0.8)  # key paths as `optimize --vary`
 >>> run = scene.trace(photons=1_000_000, seed=1)
 >>> run.flux.shape, run.efficiency                   # numpy (ny, nx) W/mm^2; (value, stderr)
+>>> run.x_mm, run.y_mm                               # bin centres (mm from the detector origin)
+>>> df = bt.sweep(scene, {"sources.*.center.2": [5, 8, 11]}, photons=1e5)  # pandas
+>>> bt.Scene.load(bt.scenes.path("notebook14"))      # the bundled scenes, installed
 
 Array conventions: ``Run.flux``, ``flux_stderr`` and ``hits`` have shape ``(ny, nx)``:
 row ``iy`` is the ``iy``-th bin along the detector's ``v`` from its origin, column ``ix``
@@ -36,6 +39,8 @@ from ._native import (
     merge,
     read_exr,
 )
+from . import scenes
+from ._study import sweep
 
 __all__ = [
     "BlutraceError",
@@ -47,4 +52,6 @@ __all__ = [
     "__version__",
     "merge",
     "read_exr",
+    "scenes",
+    "sweep",
 ]

@@ -6,6 +6,8 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 import numpy.typing as npt
 
+from . import scenes as scenes
+
 __version__: str
 
 _Path = Union[str, "PathLike[str]"]
@@ -119,7 +121,7 @@ class Scene:
         """The part at ``tag`` as an IS BSDF table, as ``blutrace bsdf`` makes it."""
 
 class Run:
-    """A finished trace, or the merge of shard runs."""
+    """A finished trace, the merge of shard runs, or a run read from an output folder."""
 
     @property
     def flux(self) -> npt.NDArray[np.float64]:
@@ -135,6 +137,61 @@ class Run:
     def angular_stderr(self) -> npt.NDArray[np.float64]: ...
     @property
     def angular_hits(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def x_mm(self) -> npt.NDArray[np.float64]:
+        """Centres of the flux map's columns (mm along u from the detector's origin)."""
+    @property
+    def y_mm(self) -> npt.NDArray[np.float64]:
+        """Centres of the flux map's rows (mm along v from the detector's origin)."""
+    @property
+    def theta_deg(self) -> npt.NDArray[np.float64]:
+        """Centres of the angular maps' rows (degrees from the normal)."""
+    @property
+    def phi_deg(self) -> npt.NDArray[np.float64]:
+        """Centres of the angular maps' columns (degrees from u towards v)."""
+    @property
+    def luminance(self) -> Optional[npt.NDArray[np.float64]]:
+        """Luminance within the detector's cone (cd/m^2), (ny, nx): the normal view."""
+    @property
+    def luminance_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def luminance_hits(self) -> Optional[npt.NDArray[np.uint64]]: ...
+    @property
+    def angular_luminance(self) -> Optional[npt.NDArray[np.float64]]:
+        """Luminance averaged over the target (cd/m^2), (n_theta, n_phi)."""
+    @property
+    def angular_luminance_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def X(self) -> Optional[npt.NDArray[np.float64]]:
+        """CIE 1931 X per flux bin (lux-scaled), spectral scenes."""
+    @property
+    def X_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def Y(self) -> Optional[npt.NDArray[np.float64]]:
+        """CIE 1931 Y per flux bin: illuminance (lux), spectral scenes."""
+    @property
+    def Y_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def Z(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def Z_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def u_prime(self) -> Optional[npt.NDArray[np.float64]]:
+        """CIE 1976 u' per flux bin (NaN without light), spectral scenes."""
+    @property
+    def u_prime_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def v_prime(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def v_prime_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def stokes(self) -> Optional[npt.NDArray[np.float64]]:
+        """Stokes S0..S3 (W/mm^2), (4, ny, nx), when polarization is traced."""
+    @property
+    def stokes_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def folder(self) -> Optional[str]:
+        """The output folder of a run read by ``Run.load``."""
     @property
     def summary(self) -> Dict[str, Any]:
         """The content of summary.json."""
@@ -156,7 +213,13 @@ class Run:
     @property
     def scene(self) -> Scene: ...
     def write(self, dir: _Path) -> List[str]:
-        """Write the command line's output set into ``dir``, all or nothing."""
+        """Write the command line's output set into ``dir``, all or nothing (a shard
+        run: ``shard.json``)."""
+    @staticmethod
+    def load(dir: _Path) -> Run:
+        """The run of an output folder (the CLI's or ``write``'s), or a shard folder."""
+    def to_xarray(self) -> Any:
+        """An xarray.Dataset of every map, its errors and hits, coordinates in mm/deg."""
 
 class Optimization:
     """The outcome of ``Scene.optimize``."""
@@ -188,6 +251,17 @@ class Characterisation:
         """The IS BSDF table's text."""
     def write(self, path: _Path) -> None:
         """Write the table to ``path``, whole or not at all."""
+
+def sweep(
+    scene: Scene,
+    vary: Mapping[str, Sequence[Any]],
+    photons: Optional[_Count] = None,
+    seed: Optional[int] = None,
+    executor: Any = None,
+    zipped: bool = False,
+    threads: Optional[int] = None,
+) -> Any:
+    """Trace every design of ``vary``: a pandas DataFrame, one row per design."""
 
 def merge(runs: Sequence[Run], partial: bool = False) -> Run:
     """Merge shard runs into the run of all their photons, bit for bit."""

@@ -14,7 +14,7 @@ use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -22,15 +22,44 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// alone, or the slab behind it), ``fates`` the fractions of the photons reflected,
 /// transmitted, absorbed and lost at each incidence, ``to_bsdf()`` the IS BSDF table, and
 /// ``write(path)`` writes it for a ``bsdf_table`` face.
+/// It pickles (its values and the table's text), so an executor can return it.
 #[pyclass(module = "blutrace", name = "Characterisation", frozen)]
 pub struct Characterisation {
-    inner: Characterised,
+    /// What the part was found to be.
+    part: String,
+    /// Per (rotation, AOI), rotation-major: reflected, transmitted, absorbed, lost.
+    fates: Vec<[f64; 4]>,
     aoi: Vec<f64>,
     rotations: Vec<f64>,
-    /// The table's comment lines: how it was made.
-    comments: Vec<String>,
+    /// The IS BSDF table's text.
+    bsdf: String,
     /// The files the scene read, which `write` must not replace.
     reads: Vec<PathBuf>,
+}
+
+impl Characterisation {
+    /// The characterisation of `inner`, its table commented with `comments`.
+    fn new(
+        inner: &Characterised,
+        aoi: Vec<f64>,
+        rotations: Vec<f64>,
+        comments: &[String],
+        reads: Vec<PathBuf>,
+    ) -> Characterisation {
+        let fates = inner
+            .fates
+            .iter()
+            .map(|f: &Fates| [f.reflected, f.transmitted, f.absorbed, f.lost])
+            .collect();
+        Characterisation {
+            part: inner.part.clone(),
+            fates,
+            aoi,
+            rotations,
+            bsdf: format::write(&inner.sections, comments),
+            reads,
+        }
+    }
 }
 
 #[pymethods]
@@ -38,7 +67,7 @@ impl Characterisation {
     /// What the part was found to be.
     #[getter]
     fn part(&self) -> String {
-        self.inner.part.clone()
+        self.part.clone()
     }
 
     /// The angles of incidence (degrees).
@@ -59,11 +88,9 @@ impl Characterisation {
     fn fates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let shape = (self.rotations.len(), self.aoi.len());
         let d = PyDict::new(py);
-        let fates = &self.inner.fates;
         let names = ["reflected", "transmitted", "absorbed", "lost"];
         for (k, name) in names.into_iter().enumerate() {
-            let of = |f: &Fates| [f.reflected, f.transmitted, f.absorbed, f.lost][k];
-            let values = fates.iter().map(of).collect();
+            let values = self.fates.iter().map(|f| f[k]).collect();
             let a = Array2::from_shape_vec(shape, values).expect("a fate per incidence");
             d.set_item(name, a.into_pyarray(py))?;
         }
@@ -72,7 +99,7 @@ impl Characterisation {
 
     /// The IS BSDF table (the text of a ``.bsdf`` file).
     fn to_bsdf(&self) -> String {
-        format::write(&self.inner.sections, &self.comments)
+        self.bsdf.clone()
     }
 
     /// Write the table to ``path`` (a ``.bsdf`` file), whole or not at all.
@@ -81,18 +108,57 @@ impl Characterisation {
         py: Python<'_>,
         #[pyo3(from_py_with = crate::convert::path_arg)] path: PathBuf,
     ) -> PyResult<()> {
-        let text = self.to_bsdf();
+        let text = &self.bsdf;
         py.detach(|| blutrace::output::atomic::write_file(&path, text.as_bytes(), &self.reads))
             .map_err(run_error)
+    }
+
+    /// It pickles as its values: `Characterisation._restore(state)`.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.get_type::<Characterisation>().getattr("_restore")?;
+        let state = (
+            self.part.clone(),
+            self.fates.clone(),
+            self.aoi.clone(),
+            self.rotations.clone(),
+            self.bsdf.clone(),
+            self.reads.clone(),
+        );
+        let args = (state,).into_pyobject(py)?.into_any();
+        PyTuple::new(py, [restore, args])
+    }
+
+    /// The inverse of pickling.
+    #[staticmethod]
+    fn _restore(state: State) -> Characterisation {
+        let (part, fates, aoi, rotations, bsdf, reads) = state;
+        Characterisation {
+            part,
+            fates,
+            aoi,
+            rotations,
+            bsdf,
+            reads,
+        }
     }
 
     fn __repr__(&self) -> String {
         format!(
             "Characterisation(part={:?}, aoi={:?}, rotations={:?})",
-            self.inner.part, self.aoi, self.rotations
+            self.part, self.aoi, self.rotations
         )
     }
 }
+
+/// What a characterisation pickles as: part, fates, aoi, rotations, table, reads.
+type State = (
+    String,
+    Vec<[f64; 4]>,
+    Vec<f64>,
+    Vec<f64>,
+    String,
+    Vec<PathBuf>,
+);
 
 /// `Scene.characterise`'s arguments (the CLI's defaults).
 pub struct Args<'a, 'py> {
@@ -115,7 +181,7 @@ pub fn characterise_scene(
     scene: &RustScene,
     args: Args<'_, '_>,
 ) -> PyResult<Characterisation> {
-    crate::scene::tag_arg(scene, args.tag)?;
+    crate::options::tag_arg(scene, args.tag)?;
     let photons = args
         .photons
         .map_or(Ok(1_000_000), |p| count(p, "photons", 1))?;
@@ -161,13 +227,13 @@ pub fn characterise_scene(
         format!("part: {}", inner.part),
         format!("{photons} photons per incidence, seed {seed}"),
     ];
-    Ok(Characterisation {
-        inner,
-        aoi: opts.aoi_deg,
-        rotations: opts.rotations_deg,
-        comments,
-        reads: scene.inputs.clone(),
-    })
+    Ok(Characterisation::new(
+        &inner,
+        opts.aoi_deg,
+        opts.rotations_deg,
+        &comments,
+        scene.inputs.clone(),
+    ))
 }
 
 /// Argument `radial_step` (degrees).

@@ -129,10 +129,42 @@ pub fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound
     })
 }
 
-/// Anything serializable, as the Python object of its JSON form (what the CLI writes).
-pub fn serialized<'py>(py: Python<'py>, v: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
-    let json = serde_json::to_value(v).map_err(|e| BlutraceError::new_err(e.to_string()))?;
-    json_to_py(py, &json)
+/// A Python object of JSON's kinds (what `json.loads` gives) as a JSON value; floats keep
+/// every bit (serde_json's own parser may round the last one), NaN becomes null.
+pub fn py_to_json(v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    use serde_json::Value as J;
+    if v.is_none() {
+        return Ok(J::Null);
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(J::Bool(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(match v.extract::<i64>() {
+            Ok(i) => J::from(i),
+            Err(_) => J::from(v.extract::<u64>()?),
+        });
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(serde_json::Number::from_f64(v.extract()?).map_or(J::Null, J::Number));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(J::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut o = serde_json::Map::new();
+        for (k, x) in d.iter() {
+            o.insert(k.extract()?, py_to_json(&x)?);
+        }
+        return Ok(J::Object(o));
+    }
+    let items: PyResult<Vec<_>> = v.try_iter()?.map(|x| py_to_json(&x?)).collect();
+    Ok(J::Array(items?))
+}
+
+/// Anything serializable as the JSON value the CLI writes of it.
+pub fn to_json(v: &impl serde::Serialize) -> PyResult<serde_json::Value> {
+    serde_json::to_value(v).map_err(|e| BlutraceError::new_err(e.to_string()))
 }
 
 /// A `ny x nx` grid (row-major, row `iy` at the `iy`-th bin from the origin) as a numpy

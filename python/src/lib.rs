@@ -2,8 +2,12 @@
 //! Python package `blutrace` (`python/blutrace/`) re-exports everything here; its
 //! docstrings and type stubs (`__init__.pyi`) are the user's reference.
 //!
-//! - `scene`: `Scene` (load, key paths, check, trace, optimize, characterise);
-//! - `run`: `Run` (numpy maps, summary, write, shards that pickle) and `merge`;
+//! - `scene_value`: the `Scene` value, which runs and optimizations hand back; `scene`: its
+//!   methods (load, key paths, check, trace, optimize, characterise);
+//! - `options`: the spellings and checks of arguments the calls share;
+//! - `run`: `Run` (numpy maps and their bin centres, summary, write, pickling) and `merge`;
+//! - `maps`: a run's maps, computed by the library or read from an output folder;
+//! - `saved`: runs pickled whole, and read back from output folders (`Run.load`);
 //! - `optimization`: `Optimization`, the outcome of `Scene.optimize`;
 //! - `characterisation`: `Characterisation`, a part as a BSDF table (`Scene.characterise`);
 //! - `detached`: long work on a thread of its own, with the GIL released, Ctrl-C
@@ -13,10 +17,14 @@
 mod characterisation;
 mod convert;
 mod detached;
+mod maps;
 mod optimization;
+mod options;
 mod progress;
 mod run;
+mod saved;
 mod scene;
+mod scene_value;
 
 use pyo3::create_exception;
 use pyo3::prelude::*;
@@ -42,7 +50,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("BlutraceError", py.get_type::<BlutraceError>())?;
     m.add("SceneError", py.get_type::<SceneError>())?;
-    m.add_class::<scene::Scene>()?;
+    m.add_class::<scene_value::Scene>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<optimization::Optimization>()?;
     m.add_class::<characterisation::Characterisation>()?;

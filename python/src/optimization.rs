@@ -2,9 +2,10 @@
 //! (Nelder-Mead, feedback) and, with `vary`, the search over numbers of the scene file,
 //! with the command line's options as keywords.
 
-use crate::convert::{arg, choice, count, run_error, serialized};
+use crate::convert::{arg, choice, count, json_to_py, py_to_json, run_error, to_json};
 use crate::detached::{Waited, detached, wait_detached};
-use crate::scene::{BACKENDS, ESTIMATORS, Scene, tag_arg, threads_arg};
+use crate::options::{BACKENDS, ESTIMATORS, tag_arg, threads_arg};
+use crate::scene_value::Scene;
 use blutrace::optics::dots::Placement;
 use blutrace::optimize::ObjectiveSpec;
 use blutrace::optimize::layout::VarySpec;
@@ -14,8 +15,8 @@ use blutrace::optimize::{
 use blutrace::scene::Scene as RustScene;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use std::path::PathBuf;
+use pyo3::types::{PyBytes, PyDict, PyTuple};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::mpsc;
 
@@ -39,10 +40,72 @@ enum Outcome {
 /// Ctrl-C ended the search early (the outcome is then that of the designs traced before
 /// it); ``write(dir)`` writes what ``blutrace optimize`` writes. A value the search could
 /// not define (a metric of a design that put no light on the target) is None.
+/// It pickles (its reports and the files `write` writes), so an executor can return it.
 #[pyclass(module = "blutrace", name = "Optimization", frozen)]
 pub struct Optimization {
-    outcome: Arc<Outcome>,
+    /// The search's outcome; `None` for one unpickled, which keeps its files instead.
+    outcome: Option<Arc<Outcome>>,
     scene: Scene,
+    summary: serde_json::Value,
+    history: serde_json::Value,
+    interrupted: bool,
+    method: Method,
+    /// The files `write` writes (path within its folder, bytes), of an unpickled one.
+    files: Vec<(PathBuf, Vec<u8>)>,
+}
+
+impl Optimization {
+    fn new(outcome: Outcome, scene: Scene) -> PyResult<Optimization> {
+        let (summary, history, interrupted, method) = match &outcome {
+            Outcome::Density(r) => (
+                to_json(&**r)?,
+                to_json(&r.history)?,
+                r.interrupted,
+                r.method,
+            ),
+            Outcome::Layout(r) => (
+                to_json(&**r)?,
+                to_json(&r.history)?,
+                r.interrupted,
+                r.method,
+            ),
+        };
+        Ok(Optimization {
+            outcome: Some(Arc::new(outcome)),
+            scene,
+            summary,
+            history,
+            interrupted,
+            method,
+            files: Vec::new(),
+        })
+    }
+}
+
+/// Write `outcome`'s files into `dir`.
+fn write_outcome(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    match outcome {
+        Outcome::Density(r) => r.write(dir),
+        Outcome::Layout(r) => r.write(dir),
+    }
+}
+
+/// Every file under `dir`, as (path within it, bytes).
+fn files_under(
+    dir: &Path,
+    within: &Path,
+    out: &mut Vec<(PathBuf, Vec<u8>)>,
+) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir.join(within))? {
+        let entry = entry?;
+        let rel = within.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            files_under(dir, &rel, out)?;
+        } else {
+            out.push((rel, std::fs::read(entry.path())?));
+        }
+    }
+    Ok(())
 }
 
 #[pymethods]
@@ -57,28 +120,19 @@ impl Optimization {
     /// `history.csv` lists them.
     #[getter]
     fn history<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        match &*self.outcome {
-            Outcome::Density(r) => serialized(py, &r.history),
-            Outcome::Layout(r) => serialized(py, &r.history),
-        }
+        json_to_py(py, &self.history)
     }
 
     /// Everything the search reports: the content of `optimize.json`.
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        match &*self.outcome {
-            Outcome::Density(r) => serialized(py, &**r),
-            Outcome::Layout(r) => serialized(py, &**r),
-        }
+        json_to_py(py, &self.summary)
     }
 
     /// Whether Ctrl-C stopped the search early (its outcome is the best design so far).
     #[getter]
     fn interrupted(&self) -> bool {
-        match &*self.outcome {
-            Outcome::Density(r) => r.interrupted,
-            Outcome::Layout(r) => r.interrupted,
-        }
+        self.interrupted
     }
 
     /// Write what `blutrace optimize` writes into `dir`, all or nothing; returns the files
@@ -88,25 +142,125 @@ impl Optimization {
         py: Python<'_>,
         #[pyo3(from_py_with = crate::convert::dir_arg)] dir: PathBuf,
     ) -> PyResult<Vec<String>> {
-        let outcome = self.outcome.clone();
-        let files = detached(py, || match &*outcome {
-            Outcome::Density(r) => r.write(&dir),
-            Outcome::Layout(r) => r.write(&dir),
-        })?
-        .map_err(run_error)?;
-        Ok(files.iter().map(|f| f.display().to_string()).collect())
+        let written = match &self.outcome {
+            Some(outcome) => {
+                let outcome = outcome.clone();
+                detached(py, || write_outcome(&outcome, &dir))?.map_err(run_error)?
+            }
+            None => {
+                let reads = &self.scene.inner.inputs;
+                let files = &self.files;
+                detached(py, || {
+                    let mut top = Vec::new();
+                    for (rel, bytes) in files {
+                        let path = dir.join(rel);
+                        if let Some(parent) = path.parent() {
+                            std::fs::create_dir_all(parent)?;
+                        }
+                        blutrace::output::atomic::write_file(&path, bytes, reads)?;
+                        let first = dir.join(
+                            rel.components()
+                                .next()
+                                .map_or(rel.as_path(), |c| Path::new(c.as_os_str())),
+                        );
+                        if !top.contains(&first) {
+                            top.push(first);
+                        }
+                    }
+                    Ok(top)
+                })?
+                .map_err(run_error)?
+            }
+        };
+        Ok(written.iter().map(|f| f.display().to_string()).collect())
+    }
+
+    /// It pickles as its scene, reports and the files `write` writes.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let files = match &self.outcome {
+            None => self.files.clone(),
+            Some(outcome) => {
+                let outcome = outcome.clone();
+                detached(py, move || {
+                    let tmp = std::env::temp_dir().join(format!(
+                        "blutrace-pickle-{}-{:x}",
+                        std::process::id(),
+                        Arc::as_ptr(&outcome) as usize
+                    ));
+                    let _ = std::fs::remove_dir_all(&tmp);
+                    let kept = write_outcome(&outcome, &tmp).and_then(|_| {
+                        let mut files = Vec::new();
+                        files_under(&tmp, Path::new(""), &mut files)?;
+                        Ok(files)
+                    });
+                    let _ = std::fs::remove_dir_all(&tmp);
+                    kept
+                })?
+                .map_err(run_error)?
+            }
+        };
+        let files: Vec<(PathBuf, Bound<'py, PyBytes>)> = files
+            .iter()
+            .map(|(p, b)| (p.clone(), PyBytes::new(py, b)))
+            .collect();
+        let state = (
+            self.scene.clone(),
+            // As Python objects: pickle keeps every bit of their floats.
+            json_to_py(py, &self.summary)?,
+            json_to_py(py, &self.history)?,
+            self.interrupted,
+            name_of_method(self.method),
+            files,
+        );
+        let restore = py.get_type::<Optimization>().getattr("_restore")?;
+        let args = (state,).into_pyobject(py)?.into_any();
+        PyTuple::new(py, [restore, args])
+    }
+
+    /// The inverse of pickling.
+    #[staticmethod]
+    fn _restore(state: &Bound<'_, PyAny>) -> PyResult<Optimization> {
+        let (scene, summary, history, interrupted, method, files): State<'_> = state.extract()?;
+        let scene: Scene = scene.cast::<Scene>()?.borrow().clone();
+        Ok(Optimization {
+            outcome: None,
+            scene,
+            summary: py_to_json(&summary)?,
+            history: py_to_json(&history)?,
+            interrupted,
+            method: choice("method", &method, METHODS)?,
+            files,
+        })
     }
 
     fn __repr__(&self) -> String {
-        let (method, n) = match &*self.outcome {
-            Outcome::Density(r) => (r.method, r.history.len()),
-            Outcome::Layout(r) => (r.method, r.history.len()),
-        };
+        let n = self.history.as_array().map_or(0, Vec::len);
         format!(
-            "Optimization(method='{method}', steps={n}, scene={:?})",
+            "Optimization(method='{}', steps={n}, scene={:?})",
+            name_of_method(self.method),
             self.scene.inner.name
         )
     }
+}
+
+/// What an optimization pickles as: the optimized scene, summary and history (as Python
+/// objects), interrupted, the method's name and the files `write` writes.
+type State<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    bool,
+    String,
+    Vec<(PathBuf, Vec<u8>)>,
+);
+
+/// The spelling of `m` in [`METHODS`].
+fn name_of_method(m: Method) -> String {
+    METHODS
+        .iter()
+        .find(|(_, x)| *x == m)
+        .map_or("?", |(n, _)| n)
+        .to_string()
 }
 
 /// `scene.optimize(method, vary, **options)`.
@@ -196,10 +350,7 @@ pub fn optimize_scene(
     }
     .map_err(run_error)?;
     let optimized = Scene::from_toml(py, toml_text, scene.path.clone())?;
-    Ok(Optimization {
-        outcome: Arc::new(outcome),
-        scene: optimized,
-    })
+    Optimization::new(outcome, optimized)
 }
 
 /// Set option `key` of `o` from a keyword argument (`progress` is kept aside).

@@ -7,68 +7,18 @@ use crate::convert::{
 };
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
+use crate::options::{BACKENDS, ESTIMATORS, TARGET_METRICS, threads_arg};
 use crate::progress;
 use crate::run::Run;
-use blutrace::accel::BackendChoice;
-use blutrace::estimator::Estimator;
-use blutrace::run::{self, Interrupt, Progress, RunOptions, Shard, TargetMetric};
+use crate::scene_value::{Scene, load_scene};
+use blutrace::run::{self, Interrupt, Progress, RunOptions, Shard};
 use blutrace::scene::{Scene as RustScene, key_path};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Spellings of the estimators, as on the command line.
-pub const ESTIMATORS: &[(&str, Estimator)] = &[
-    ("analog", Estimator::Analog),
-    ("weighted", Estimator::Weighted),
-];
-
-/// Spellings of the intersection backends.
-pub const BACKENDS: &[(&str, BackendChoice)] = &[
-    ("auto", BackendChoice::Auto),
-    ("embree", BackendChoice::Embree),
-    ("bvh", BackendChoice::Bvh),
-    ("brute", BackendChoice::Brute),
-];
-
-/// Spellings of the target metrics.
-const TARGET_METRICS: &[(&str, TargetMetric)] = &[
-    ("mean", TargetMetric::Mean),
-    ("efficiency", TargetMetric::Efficiency),
-    ("cv", TargetMetric::Cv),
-    ("nine-point", TargetMetric::NinePoint),
-    ("thirteen-point", TargetMetric::ThirteenPoint),
-    ("bin", TargetMetric::Bin),
-];
-
-/// A validated, traceable scene: a value (``copy()`` gives an independent one).
-///
-/// ``Scene.load(path)`` reads a scene file, or ``scene.toml`` in a folder, and every file it
-/// names; ``Scene.from_toml(text, path)`` builds one from text (geometry relative to
-/// ``path``'s folder). ``get(key)`` and ``set(key, value)`` read and change the scene file's
-/// values by key path: dotted keys and array indices from 0 (``sources.0.center.2``), ``*``
-/// for every element of an array (``sources.*.center.2``: ``get`` gives their one value, or
-/// the list of their values when they differ); ``set`` takes numbers, str, lists, dicts and
-/// numpy arrays and scalars, and loads the scene again from the edited file, so every
-/// check runs. ``check()`` returns what ``blutrace check --json`` prints.
-#[pyclass(module = "blutrace", name = "Scene")]
-#[derive(Clone)]
-pub struct Scene {
-    /// The scene.
-    pub inner: Arc<RustScene>,
-}
-
-/// The scene file a path names: the path, or `scene.toml` in it when it is a folder.
-fn scene_file(p: &Path) -> PathBuf {
-    if p.is_dir() {
-        p.join("scene.toml")
-    } else {
-        p.to_path_buf()
-    }
-}
 
 #[pymethods]
 impl Scene {
@@ -78,11 +28,7 @@ impl Scene {
         py: Python<'_>,
         #[pyo3(from_py_with = convert::path_arg)] path: PathBuf,
     ) -> PyResult<Scene> {
-        let file = scene_file(&path);
-        let scene = detached(py, || RustScene::load(&file))?.map_err(scene_error)?;
-        Ok(Scene {
-            inner: Arc::new(scene),
-        })
+        load_scene(py, &path)
     }
 
     /// A scene from the text of a scene file; its geometry paths are relative to `path`'s
@@ -278,7 +224,7 @@ impl Scene {
         );
         // An interrupt or error of the trace outranks one of the progress display.
         let closed = progress::close(py, &reporter, done.load(Ordering::Relaxed));
-        let run = Run::new(traced?.map_err(run_error)?);
+        let run = Run::new(traced?.map_err(run_error)?)?;
         closed?;
         Ok(run)
     }
@@ -294,18 +240,95 @@ impl Scene {
     /// line per iteration on stderr) or a callable taking each iteration's record (a dict).
     /// Ctrl-C stops the search: it returns the outcome of the designs traced before it, with
     /// ``interrupted`` True (before the first design, ``KeyboardInterrupt`` is raised).
-    #[pyo3(signature = (method=None, vary=None, **options))]
-    fn optimize(
+    #[pyo3(signature = (method=None, vary=None, *, objective=None, grid_points=None, photons=None, seed=None, max_iter=None, target_cv=None, degree=None, min_density=None, max_density=None, tag=None, initial_step=None, simplex_tol=None, alpha=None, smoothing=None, dims=None, cells=None, strips=None, edge_margin_mm=None, verify_photons=None, verify_seed=None, threads=None, estimator=None, backend=None, export_placement=None, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn optimize<'py>(
         &self,
-        py: Python<'_>,
-        method: Option<&Bound<'_, PyAny>>,
-        vary: Option<&Bound<'_, PyAny>>,
-        options: Option<&Bound<'_, PyDict>>,
+        py: Python<'py>,
+        method: Option<&Bound<'py, PyAny>>,
+        vary: Option<&Bound<'py, PyAny>>,
+        objective: Option<&Bound<'py, PyAny>>,
+        grid_points: Option<&Bound<'py, PyAny>>,
+        photons: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
+        max_iter: Option<&Bound<'py, PyAny>>,
+        target_cv: Option<&Bound<'py, PyAny>>,
+        degree: Option<&Bound<'py, PyAny>>,
+        min_density: Option<&Bound<'py, PyAny>>,
+        max_density: Option<&Bound<'py, PyAny>>,
+        tag: Option<&Bound<'py, PyAny>>,
+        initial_step: Option<&Bound<'py, PyAny>>,
+        simplex_tol: Option<&Bound<'py, PyAny>>,
+        alpha: Option<&Bound<'py, PyAny>>,
+        smoothing: Option<&Bound<'py, PyAny>>,
+        dims: Option<&Bound<'py, PyAny>>,
+        cells: Option<&Bound<'py, PyAny>>,
+        strips: Option<&Bound<'py, PyAny>>,
+        edge_margin_mm: Option<&Bound<'py, PyAny>>,
+        verify_photons: Option<&Bound<'py, PyAny>>,
+        verify_seed: Option<&Bound<'py, PyAny>>,
+        threads: Option<&Bound<'py, PyAny>>,
+        estimator: Option<&Bound<'py, PyAny>>,
+        backend: Option<&Bound<'py, PyAny>>,
+        export_placement: Option<&Bound<'py, PyAny>>,
+        progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Optimization> {
         let method: Option<String> = method.map(|m| arg(m, "method")).transpose()?;
         let vary: Option<Bound<'_, PyDict>> = vary.map(|v| arg(v, "vary")).transpose()?;
         let (method, vary) = (method.as_deref(), vary.as_ref());
-        optimization::optimize_scene(py, &self.inner, method, vary, options)
+        // The options given, by name: those left out keep the method's defaults.
+        let given = PyDict::new(py);
+        for (name, value) in [
+            ("photons", photons),
+            ("seed", seed),
+            ("max_iter", max_iter),
+            ("target_cv", target_cv),
+            ("objective", objective),
+            ("grid_points", grid_points),
+            ("degree", degree),
+            ("min_density", min_density),
+            ("max_density", max_density),
+            ("tag", tag),
+            ("initial_step", initial_step),
+            ("simplex_tol", simplex_tol),
+            ("alpha", alpha),
+            ("smoothing", smoothing),
+            ("dims", dims),
+            ("cells", cells),
+            ("strips", strips),
+            ("edge_margin_mm", edge_margin_mm),
+            ("verify_photons", verify_photons),
+            ("verify_seed", verify_seed),
+            ("threads", threads),
+            ("estimator", estimator),
+            ("backend", backend),
+            ("export_placement", export_placement),
+            ("progress", progress),
+        ] {
+            if let Some(v) = value {
+                given.set_item(name, v)?;
+            }
+        }
+        optimization::optimize_scene(py, &self.inner, method, vary, Some(&given))
+    }
+
+    /// Scenes are equal when their scene files (with any `set` applied) and every file
+    /// they name are: `scene == scene.copy()`, and a scene differs once `set` changes it.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        match other.cast::<Scene>() {
+            Ok(o) => {
+                let o = &o.borrow().inner;
+                self.inner.source() == o.source()
+                    && self.inner.content_hash() == o.content_hash()
+                    && self.inner.path == o.path
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn _repr_html_<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let study = slf.py().import("blutrace._study")?;
+        study.call_method1("scene_html", (slf,))
     }
 
     /// Characterise a part of the scene into an IS BSDF table, as ``blutrace bsdf`` does:
@@ -409,29 +432,5 @@ fn shard_arg(v: &Bound<'_, PyAny>) -> PyResult<Shard> {
     Ok(Shard {
         index: index as u64,
         count: count as u64,
-    })
-}
-
-/// `threads=n` checked: 1..=MAX_THREADS.
-pub fn threads_arg(t: &Bound<'_, PyAny>) -> PyResult<usize> {
-    let n = count(t, "threads", 1)?;
-    if n > run::MAX_THREADS as u64 {
-        return Err(PyValueError::new_err(format!(
-            "threads must be within 1..={}, got {n}",
-            run::MAX_THREADS
-        )));
-    }
-    Ok(n as usize)
-}
-
-/// Argument `tag` checked: the index of a tag of `scene`, else a `ValueError` listing them
-/// (the same for every call that names a part by its tag).
-pub fn tag_arg(scene: &RustScene, tag: &str) -> PyResult<usize> {
-    scene.tags.iter().position(|t| t == tag).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "tag: no tag '{tag}' in {} (its tags: {})",
-            scene.path.display(),
-            scene.tags.join(", ")
-        ))
     })
 }

@@ -6,6 +6,8 @@ import pathlib
 import subprocess
 import sys
 
+import pytest
+
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -41,3 +43,18 @@ def test_the_ink_albedo_comparison_ranks_the_albedos(tmp_path):
     out = run_example("ink_albedo.py", "--photons", "5e4", "--albedos", "0.5,0.95", cwd=tmp_path)
     effs = [float(line.split()[1]) for line in out.splitlines()[2:]]
     assert len(effs) == 2 and effs[1] > effs[0], out  # whiter ink wastes less light
+
+
+def test_the_design_study_sweeps_to_a_dataframe_and_plots_in_mm(tmp_path):
+    pytest.importorskip("pandas")
+    pytest.importorskip("matplotlib")
+    out = run_example(
+        "design_study.py", "--photons", "2e4", "--albedos", "0.5,0.9", "--out",
+        str(tmp_path / "study"), cwd=tmp_path,
+    )
+    assert "most uniform: surfaces.lgp_back.ink_albedo = " in out
+    csv = (tmp_path / "study" / "study.csv").read_text().splitlines()
+    assert csv[0].startswith("surfaces.lgp_back.ink_albedo,") and len(csv) == 3
+    assert "efficiency_stderr" in csv[0]
+    png = (tmp_path / "study" / "flux_mm.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"

@@ -4,8 +4,9 @@
 //!   white) on the photometric scale (Y = 1 is 1 lux), so any EXR viewer shows its true
 //!   colour; `X`, `Y`, `Z` = CIE 1931 tristimulus values (lux-scaled: `Y` is the
 //!   illuminance, lm/m² per bin); `stderr.X`, `stderr.Y`, `stderr.Z` their standard
-//!   errors; `u_prime`, `v_prime` = CIE 1976 chromaticity per bin (NaN where no light);
-//!   `hits` = photons per bin. Header attributes as `flux.exr`'s.
+//!   errors; `u_prime`, `v_prime` = CIE 1976 chromaticity per bin (NaN where no light),
+//!   `stderr.u_prime`, `stderr.v_prime` their jackknife errors
+//!   ([`super::metrics::color::uv_prime_maps`]); `hits` = photons per bin. Header attributes as `flux.exr`'s.
 //! - `color.png`: the same light as an sRGB picture, one block of pixels per bin, scaled
 //!   so the brightest bin's largest sRGB component is full scale (so it shows colour and
 //!   its variation, not absolute brightness).
@@ -15,7 +16,7 @@
 use super::RunResult;
 use super::images::f32s;
 use super::metrics::Map;
-use super::metrics::color::xyz_maps;
+use super::metrics::color::{uv_prime_maps, xyz_maps};
 use crate::color::{UvPrime, Xyz};
 use crate::output::atomic::SetDir;
 use crate::output::exr::{Samples, write_channels};
@@ -40,24 +41,20 @@ pub(super) fn write_color_images(run: &RunResult, staged: &SetDir) -> Result<()>
     let Some(xyz) = xyz_maps(&run.scene, &run.tally) else {
         return Ok(());
     };
+    let Some(uv_maps) = uv_prime_maps(&run.scene, &run.tally, &run.groups) else {
+        return Ok(());
+    };
     let rgb = linear_srgb(&xyz);
-    let uv: Vec<Option<UvPrime>> = (0..xyz[0].value.len())
-        .map(|i| bin_xyz(&xyz, i).uv_prime())
+    let [u, v] = [&uv_maps[0].value, &uv_maps[1].value];
+    let uv: Vec<Option<UvPrime>> = (0..u.len())
+        .map(|i| (!u[i].is_nan()).then(|| UvPrime { u: u[i], v: v[i] }))
         .collect();
-    write_exr(run, staged, &xyz, &rgb, &uv)?;
+    write_exr(run, staged, &xyz, &rgb, &uv_maps)?;
     staged.write_with("color.png", |path| {
         write_true_colour(run, path, &xyz[0], &rgb)
     })?;
     staged.write_with("delta_uv.png", |path| write_delta_uv(run, path, &xyz, &uv))?;
     Ok(())
-}
-
-fn bin_xyz(xyz: &[Map; 3], i: usize) -> Xyz {
-    Xyz {
-        x: xyz[0].value[i],
-        y: xyz[1].value[i],
-        z: xyz[2].value[i],
-    }
 }
 
 /// Linear sRGB per bin, channel-major.
@@ -74,24 +71,18 @@ fn write_exr(
     staged: &SetDir,
     xyz: &[Map; 3],
     rgb: &[Vec<f64>; 3],
-    uv: &[Option<UvPrime>],
+    uv: &[Map; 2],
 ) -> Result<()> {
     let comments = "blutrace colour map: R, G, B = linear sRGB (D65) of the light on the target, \
          Y = 1 being 1 lux; X, Y, Z = CIE 1931 tristimulus values (Y = illuminance, lm/m^2 per \
          bin); stderr.X/Y/Z their standard errors; u_prime, v_prime = CIE 1976 chromaticity \
-         per bin; hits = photons per bin; x along detector_u, y along detector_v";
+         per bin, stderr.u_prime/v_prime their standard errors; hits = photons per bin; x along detector_u, y along detector_v";
     let attrs = super::images::map_attributes(run, "lx (lm/m^2)", comments);
     let (r, g, b) = (f32s(&rgb[0]), f32s(&rgb[1]), f32s(&rgb[2]));
     let [x, y, z] = [0, 1, 2].map(|k| f32s(&xyz[k].value));
     let [xe, ye, ze] = [0, 1, 2].map(|k| f32s(&xyz[k].stderr));
-    let u: Vec<f32> = uv
-        .iter()
-        .map(|p| p.map_or(f32::NAN, |p| p.u as f32))
-        .collect();
-    let v: Vec<f32> = uv
-        .iter()
-        .map(|p| p.map_or(f32::NAN, |p| p.v as f32))
-        .collect();
+    let [u, v] = [0, 1].map(|k| f32s(&uv[k].value));
+    let [ue, ve] = [0, 1].map(|k| f32s(&uv[k].stderr));
     let hits: Vec<f32> = xyz[0].hits.iter().map(|&h| h as f32).collect();
     let (nx, ny) = (xyz[0].nx, xyz[0].ny);
     staged.write_with("color.exr", |path| {
@@ -107,6 +98,8 @@ fn write_exr(
             ("stderr.Z", Samples::F32(&ze)),
             ("u_prime", Samples::F32(&u)),
             ("v_prime", Samples::F32(&v)),
+            ("stderr.u_prime", Samples::F32(&ue)),
+            ("stderr.v_prime", Samples::F32(&ve)),
             ("hits", Samples::F32(&hits)),
         ];
         write_channels(path, nx, ny, &channels, &attrs)

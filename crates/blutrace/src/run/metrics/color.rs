@@ -30,6 +30,48 @@ pub fn xyz_maps(scene: &Scene, t: &Tally) -> Option<[Map; 3]> {
     }))
 }
 
+/// CIE 1976 u' and v' per flux bin (NaN where no light), each with its delete-one-group
+/// jackknife standard error over `groups` (X, Y and Z of a bin are correlated, so their
+/// own errors do not give u'v''s), or `None` for a monochrome run. The values are those
+/// of `color.exr` (from [`xyz_maps`]); `hits` are the bins' photons.
+pub fn uv_prime_maps(scene: &Scene, total: &Tally, groups: &[Tally]) -> Option<[Map; 2]> {
+    let xyz = xyz_maps(scene, total)?;
+    let sums = |t: &Tally, i: usize| -> Option<[f64; 3]> {
+        let c = t.color.as_ref()?;
+        Some([0, 1, 2].map(|k| c.flux[k].bins[i].sum.value()))
+    };
+    let uv = |[x, y, z]: [f64; 3]| {
+        Xyz { x, y, z }
+            .uv_prime()
+            .map_or([f64::NAN; 2], |p| [p.u, p.v])
+    };
+    let lit: Vec<&Tally> = groups.iter().filter(|g| g.ledger.photons > 0).collect();
+    let n = xyz[0].value.len();
+    let mut maps = [0, 1].map(|_| Map {
+        nx: xyz[0].nx,
+        ny: xyz[0].ny,
+        value: Vec::with_capacity(n),
+        stderr: Vec::with_capacity(n),
+        hits: xyz[1].hits.clone(),
+    });
+    for i in 0..n {
+        let own = uv([0, 1, 2].map(|k| xyz[k].value[i]));
+        let all = sums(total, i)?;
+        let leave_out: Vec<[f64; 2]> = lit
+            .iter()
+            .filter_map(|g| sums(g, i))
+            .map(|s| uv([0, 1, 2].map(|k| all[k] - s[k])))
+            .collect();
+        for (c, m) in maps.iter_mut().enumerate() {
+            m.value.push(own[c]);
+            m.stderr.push(jackknife_stderr(
+                &leave_out.iter().map(|l| l[c]).collect::<Vec<_>>(),
+            ));
+        }
+    }
+    Some(maps)
+}
+
 /// `summary.json`'s `color`: the target's colour and its non-uniformity.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ColorSummary {

@@ -71,6 +71,7 @@ class Scene:
         progress: _TraceProgress = None,
         shard: Optional[Tuple[int, int]] = None,
         backend: str = "auto",
+        luminance_estimator: str = "meter",
     ) -> Run:
         """Trace the scene (the GIL is released; Ctrl-C raises KeyboardInterrupt)."""
     def optimize(
@@ -154,6 +155,14 @@ class Run:
         """Luminance within the detector's cone (cd/m^2), (ny, nx): the normal view."""
     @property
     def luminance_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def luminance_views(self) -> Optional[npt.NDArray[np.float64]]:
+        """Every view's luminance map (cd/m^2), (n_views, ny, nx); the first is ``luminance``."""
+    @property
+    def luminance_views_stderr(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def views_deg(self) -> List[List[float]]:
+        """The views of ``luminance_views``: [theta_deg, phi_deg] each."""
     @property
     def luminance_hits(self) -> Optional[npt.NDArray[np.uint64]]: ...
     @property

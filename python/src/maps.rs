@@ -45,6 +45,10 @@ pub struct Maps {
     pub angular: Map,
     /// Luminance within the detector's cone (cd/m^2) per flux bin: the normal view.
     pub luminance: Option<Map>,
+    /// Per view of the detector (`[detector] views`, the first = `luminance`), its
+    /// luminance map (cd/m^2) and its `[theta_deg, phi_deg]`; empty without lumens or
+    /// spectra.
+    pub luminance_views: Vec<(Map, [f64; 2])>,
     /// Luminance averaged over the target (cd/m^2) per angular bin.
     pub angular_luminance: Option<Map>,
     /// CIE 1931 X, Y, Z per flux bin (lux-scaled), spectral scenes.
@@ -68,7 +72,10 @@ impl Maps {
             },
             flux: run.flux_map(),
             angular: run.angular_map(),
-            luminance: cone::luminance_cone_map(scene, t),
+            luminance: cone::luminance_cone_map(scene, t, 0),
+            luminance_views: (0..d.views.len())
+                .filter_map(|k| Some((cone::luminance_cone_map(scene, t, k)?, d.views[k])))
+                .collect(),
             angular_luminance: metrics::luminance_map(scene, t),
             xyz: color::xyz_maps(scene, t),
             uv: color::uv_prime_maps(scene, t, &run.groups),
@@ -112,6 +119,7 @@ impl Maps {
             ]),
             None => None,
         };
+        let luminance_views = read_views(dir, luminance.as_ref())?;
         let angular_luminance = if angular.has("luminance.Y") {
             Some(angular.map("luminance.Y", "luminance_stderr.Y", "hits.Y")?)
         } else {
@@ -124,6 +132,7 @@ impl Maps {
             luminance: luminance
                 .map(|l| l.map("Y", "stderr.Y", "hits.Y"))
                 .transpose()?,
+            luminance_views,
             angular_luminance,
             xyz,
             uv,
@@ -132,12 +141,30 @@ impl Maps {
     }
 }
 
+/// The luminance maps of every view in `dir`: `first` (`luminance.exr`), then
+/// `luminance-view-K.exr` for K = 1, 2, ... while they exist; each view's angles from its
+/// header (NaN in files written before views).
+fn read_views(dir: &Path, first: Option<&Image>) -> Result<Vec<(Map, [f64; 2])>> {
+    let Some(first) = first else {
+        return Ok(Vec::new());
+    };
+    let mut views = vec![(first.map("Y", "stderr.Y", "hits.Y")?, first.view())];
+    for k in 1.. {
+        let Some(image) = Image::read(&dir.join(format!("luminance-view-{k}.exr")))? else {
+            break;
+        };
+        views.push((image.map("Y", "stderr.Y", "hits.Y")?, image.view()));
+    }
+    Ok(views)
+}
+
 /// An EXR image of an output folder, its channels by name.
 struct Image {
     path: std::path::PathBuf,
     width: usize,
     height: usize,
     channels: Vec<(String, Vec<f32>)>,
+    attributes: Vec<(String, blutrace::output::exr::Attribute)>,
 }
 
 impl Image {
@@ -146,13 +173,28 @@ impl Image {
         if !path.is_file() {
             return Ok(None);
         }
-        let (width, height, channels, _) = blutrace::output::exr::read_channels(path)?;
+        let (width, height, channels, attributes) = blutrace::output::exr::read_channels(path)?;
         Ok(Some(Image {
             path: path.to_path_buf(),
             width,
             height,
             channels,
+            attributes,
         }))
+    }
+
+    /// A luminance map's view `[theta_deg, phi_deg]` from its header (NaN when absent).
+    fn view(&self) -> [f64; 2] {
+        ["view_theta_deg", "view_phi_deg"].map(|key| {
+            self.attributes
+                .iter()
+                .find(|(n, _)| n == key)
+                .and_then(|(_, a)| match a {
+                    blutrace::output::exr::Attribute::Text(t) => t.parse().ok(),
+                    _ => None,
+                })
+                .unwrap_or(f64::NAN)
+        })
     }
 
     fn has(&self, name: &str) -> bool {

@@ -2,7 +2,7 @@
 
 use crate::convert::count;
 use blutrace::accel::BackendChoice;
-use blutrace::estimator::Estimator;
+use blutrace::estimator::{Estimator, LuminanceEstimator};
 use blutrace::run::{self, TargetMetric};
 use blutrace::scene::Scene as RustScene;
 use pyo3::exceptions::PyValueError;
@@ -12,6 +12,12 @@ use pyo3::prelude::*;
 pub const ESTIMATORS: &[(&str, Estimator)] = &[
     ("analog", Estimator::Analog),
     ("weighted", Estimator::Weighted),
+];
+
+/// Spellings of the luminance maps' estimators.
+pub const LUMINANCE_ESTIMATORS: &[(&str, LuminanceEstimator)] = &[
+    ("meter", LuminanceEstimator::Meter),
+    ("cone", LuminanceEstimator::Cone),
 ];
 
 /// Spellings of the intersection backends.

@@ -127,6 +127,22 @@ fn stacked<'py>(
     py.import("numpy")?.call_method1("stack", (layers,))
 }
 
+impl Run {
+    /// `which` part of every view's luminance map, stacked `(n_views, ny, nx)`.
+    fn views_part<'py>(&self, py: Python<'py>, which: Part) -> PyResult<Bound<'py, PyAny>> {
+        if self.maps.luminance_views.is_empty() {
+            return Ok(py.None().into_bound(py));
+        }
+        let layers: Vec<Bound<'py, PyAny>> = self
+            .maps
+            .luminance_views
+            .iter()
+            .map(|(m, _)| part(py, Some(m), which))
+            .collect::<PyResult<_>>()?;
+        py.import("numpy")?.call_method1("stack", (layers,))
+    }
+}
+
 #[pymethods]
 impl Run {
     /// Irradiance on the target plane (W/mm^2 per bin), float64 `(ny, nx)`; row `iy` is
@@ -208,6 +224,27 @@ impl Run {
     #[getter]
     fn luminance_hits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         part(py, self.maps.luminance.as_ref(), Part::Hits)
+    }
+
+    /// The luminance maps of every view of the detector (`[detector] views`), stacked
+    /// `(n_views, ny, nx)` (cd/m^2; the first is `luminance`); None without lumens or
+    /// spectra.
+    #[getter]
+    fn luminance_views<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.views_part(py, Part::Value)
+    }
+
+    /// Standard errors of `luminance_views`, `(n_views, ny, nx)`.
+    #[getter]
+    fn luminance_views_stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.views_part(py, Part::Stderr)
+    }
+
+    /// The views of `luminance_views`: `[theta_deg, phi_deg]` each (theta from the
+    /// detector normal, phi from its u axis towards v).
+    #[getter]
+    fn views_deg(&self) -> Vec<[f64; 2]> {
+        self.maps.luminance_views.iter().map(|(_, v)| *v).collect()
     }
 
     /// Luminance (cd/m^2, averaged over the target) per angular bin `(n_theta, n_phi)`

@@ -7,7 +7,7 @@ use crate::convert::{
 };
 use crate::detached::{detached, run_detached};
 use crate::optimization::{self, Optimization};
-use crate::options::{BACKENDS, ESTIMATORS, TARGET_METRICS, threads_arg};
+use crate::options::{BACKENDS, ESTIMATORS, LUMINANCE_ESTIMATORS, TARGET_METRICS, threads_arg};
 use crate::progress;
 use crate::run::Run;
 use crate::scene_value::{Scene, load_scene};
@@ -165,10 +165,11 @@ impl Scene {
     /// at or below it; ``max_time`` stops after about that many seconds; ``progress`` is True
     /// (a tqdm bar when tqdm is installed, else a line on stderr) or a callable
     /// ``(photons_done, photons_total)``; ``shard=(k, m)`` traces only shard k of m of the
-    /// photons, for ``merge``.
+    /// photons, for ``merge``; ``luminance_estimator`` is "meter" (peel-off towards each
+    /// view, the default) or "cone" (the photons that leave within the cone).
     #[pyo3(signature = (photons=None, seed=None, threads=None, estimator="analog",
         target_error=None, target_metric="mean", max_time=None, progress=None, shard=None,
-        backend="auto"))]
+        backend="auto", luminance_estimator="meter"))]
     #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
@@ -183,6 +184,7 @@ impl Scene {
         progress: Option<&Bound<'_, PyAny>>,
         shard: Option<&Bound<'_, PyAny>>,
         #[pyo3(from_py_with = backend_arg)] backend: &str,
+        #[pyo3(from_py_with = luminance_estimator_arg)] luminance_estimator: &str,
     ) -> PyResult<Run> {
         let target_error: Option<f64> = target_error.map(|v| arg(v, "target_error")).transpose()?;
         let max_time: Option<f64> = max_time.map(|v| arg(v, "max_time")).transpose()?;
@@ -199,6 +201,11 @@ impl Scene {
             threads: threads.map(|t| threads_arg(t)).transpose()?,
             backend: choice("backend", backend, BACKENDS)?,
             estimator: choice("estimator", estimator, ESTIMATORS)?,
+            luminance_estimator: choice(
+                "luminance_estimator",
+                luminance_estimator,
+                LUMINANCE_ESTIMATORS,
+            )?,
             target_error,
             target_metric: choice("target_metric", target_metric, TARGET_METRICS)?,
             max_time_s: max_time,
@@ -409,6 +416,11 @@ fn estimator_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
 /// Argument `target_metric`: one of [`TARGET_METRICS`].
 fn target_metric_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
     spelling(v, "target_metric", TARGET_METRICS)
+}
+
+/// Argument `luminance_estimator`: one of [`LUMINANCE_ESTIMATORS`].
+fn luminance_estimator_arg(v: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    spelling(v, "luminance_estimator", LUMINANCE_ESTIMATORS)
 }
 
 /// Argument `backend`: one of [`BACKENDS`].

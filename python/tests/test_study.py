@@ -40,7 +40,7 @@ def color_run(color_scene) -> bt.Run:
 
 @pytest.fixture(scope="module")
 def polarized(box) -> bt.Run:
-    text = box.to_toml().replace("[trace]\n", "[trace]\npolarization = true\n")
+    text = box.to_toml().replace("polarization = false", "polarization = true")
     assert "polarization = true" in text
     return bt.Scene.from_toml(text, box.path).trace(photons=N, seed=4)
 

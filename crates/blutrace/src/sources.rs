@@ -29,7 +29,7 @@ pub mod spectrum;
 
 use crate::geometry::Ray;
 use crate::optics::medium::{Medium, MediumId, medium_id};
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -415,8 +415,10 @@ pub struct Emission {
     pub medium: MediumId,
     /// The index of the source that emitted it.
     pub source: usize,
-    /// Its light (see [`crate::optics::spectrum`]).
+    /// Its light (see [`crate::optics::spectrum`]): the hero wavelength...
     pub light: Light,
+    /// ...and the others it carries along the hero's path.
+    pub secondaries: Secondaries,
 }
 
 impl Source {
@@ -536,10 +538,14 @@ impl Sources {
             .min(self.list.len() - 1);
         let s = &self.list[i];
         let (ray, normal, own_nm) = s.emitter.emit_nm(rng);
-        let light = match (own_nm, &s.spectrum) {
-            (Some(nm), _) => Light::at_nm(nm),
-            (None, Some(sp)) => Light::at_nm(sp.sample(rng.uniform())),
-            (None, None) => Light::MONOCHROME,
+        let (light, secondaries) = match (own_nm, &s.spectrum) {
+            (Some(nm), _) => (Light::at_nm(nm), Secondaries::NONE),
+            (None, Some(sp)) => {
+                let u = rng.uniform();
+                let others = Secondaries::stratified(u, |v| sp.sample(v));
+                (Light::at_nm(sp.sample(u)), others)
+            }
+            (None, None) => (Light::MONOCHROME, Secondaries::NONE),
         };
         Emission {
             ray,
@@ -547,6 +553,7 @@ impl Sources {
             medium: s.medium,
             source: i,
             light,
+            secondaries,
         }
     }
 

@@ -20,6 +20,7 @@
 mod body_boxes;
 mod flight;
 mod solid_walk;
+mod spectral;
 mod tir_run;
 
 use crate::accel::Accel;
@@ -28,7 +29,7 @@ use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::absorber::Absorber;
 use crate::optics::model::Arrival;
 use crate::optics::polarization::Polarization;
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::optics::two_sided;
 use crate::rng::PhotonRng;
@@ -71,6 +72,9 @@ pub struct Tracer<'a> {
     walks: Walks<'a>,
     /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
     bodies: BodyBoxes,
+    /// Photons of spectral sources carry their secondary wavelengths ([`spectral`]);
+    /// off, one wavelength each (the tests' reference).
+    hero: bool,
 }
 
 /// A photon in flight.
@@ -79,8 +83,10 @@ struct Photon {
     ray: SpawnedRay,
     medium: MediumId,
     weight: f64,
-    /// Its light, drawn with its emission: what it meets is read at it.
+    /// Its light, drawn with its emission: what it meets is read at it (the hero)...
     light: Light,
+    /// ...and the other wavelengths it carries along ([`spectral`]).
+    secondaries: Secondaries,
     /// Its polarization, when the scene traces it.
     pol: Option<Polarization>,
     /// Analog estimator: the optical depth of clear-medium absorption the photon has
@@ -117,6 +123,7 @@ impl<'a> Tracer<'a> {
             facets,
             walks: Walks::new(scene, convex, &bodies),
             bodies,
+            hero: true,
         }
     }
 
@@ -129,6 +136,11 @@ impl<'a> Tracer<'a> {
             medium: e.medium,
             weight: 1.0,
             light: e.light,
+            secondaries: if self.hero {
+                e.secondaries
+            } else {
+                Secondaries::NONE
+            },
             pol: self
                 .scene
                 .polarized
@@ -173,7 +185,7 @@ impl<'a> Tracer<'a> {
             if let Some((_, ab)) = detected {
                 let weight = p.light.detected(p.weight);
                 out.detections
-                    .push(detection(scene, ab, true_ray.dir, weight, p.light));
+                    .push(detection(scene, ab, true_ray.dir, weight, p));
                 if let Some(pol) = &p.pol {
                     out.stokes.push(scene.detector.stokes_of(pol, true_ray.dir));
                 }
@@ -204,6 +216,7 @@ impl<'a> Tracer<'a> {
                     weight,
                 } => {
                     p.reweigh(weight, struck.sink(&mut out.ledger));
+                    p.scattered_by(model, feature, &scene.media, self.estimator);
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                     if p.pol.is_some() {
@@ -332,8 +345,14 @@ impl<'a> Tracer<'a> {
         let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
         if medium.scattering.scatters() {
             let eps = self.scene.spawn_eps;
+            p.enters_scattering(medium);
             let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
             let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
+            match flight {
+                Flight::Reached => p.crossed(medium, t, self.estimator),
+                Flight::Scattered { t, .. } => p.crossed(medium, t, self.estimator),
+                Flight::Absorbed => {}
+            }
             if let Flight::Scattered { t, dir } = flight {
                 // Inside the medium, clear of surfaces: the search needs no nudge.
                 p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
@@ -345,6 +364,7 @@ impl<'a> Tracer<'a> {
         if absorb_clear(p, medium.absorption(p.light), t, self.estimator, rng, sink) {
             Flight::Absorbed
         } else {
+            p.crossed(medium, t, self.estimator);
             Flight::Reached
         }
     }
@@ -494,19 +514,15 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
     }
 }
 
-fn detection(
-    scene: &Scene,
-    ab: [f64; 2],
-    dir: glam::DVec3,
-    weight: f64,
-    light: Light,
-) -> Detection {
+/// The detection of `p` (scoring `weight`) crossing the target at `ab` along `dir`.
+fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64, p: &Photon) -> Detection {
     let d = &scene.detector;
     Detection {
         flux_bin: d.flux_index(ab) as u32,
         angular_bin: d.angular_index(dir) as u32,
         weight,
-        light,
+        light: p.light,
+        secondaries: p.secondaries,
         in_cone: d.in_cone(dir),
     }
 }

@@ -72,9 +72,8 @@ pub struct Tracer<'a> {
     walks: Walks<'a>,
     /// The lamp bodies of each medium and their boxes ([`body_boxes`]).
     bodies: BodyBoxes,
-    /// Photons of spectral sources carry their secondary wavelengths ([`spectral`]);
-    /// off, one wavelength each (the tests' reference).
-    hero: bool,
+    /// Which wavelengths photons of spectral sources carry ([`spectral`]).
+    wavelengths: spectral::Carried,
 }
 
 /// A photon in flight.
@@ -123,7 +122,7 @@ impl<'a> Tracer<'a> {
             facets,
             walks: Walks::new(scene, convex, &bodies),
             bodies,
-            hero: true,
+            wavelengths: spectral::Carried::Hero,
         }
     }
 
@@ -135,12 +134,8 @@ impl<'a> Tracer<'a> {
             ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
             medium: e.medium,
             weight: 1.0,
-            light: e.light,
-            secondaries: if self.hero {
-                e.secondaries
-            } else {
-                Secondaries::NONE
-            },
+            light: self.wavelengths.light(&e),
+            secondaries: self.wavelengths.secondaries(&e),
             pol: self
                 .scene
                 .polarized

@@ -89,6 +89,11 @@ impl Secondaries {
         *self = Secondaries::NONE;
     }
 
+    /// The light of the `k`-th (from 0), if they are carried.
+    pub fn light(&self, k: usize) -> Option<Light> {
+        (self.live && k < SECONDARIES).then(|| Light::at_nm(self.nm[k]))
+    }
+
     /// Their lights.
     fn lights(&self) -> impl Iterator<Item = Light> + '_ {
         self.nm.iter().map(|&nm| Light::at_nm(nm))

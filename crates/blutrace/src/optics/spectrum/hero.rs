@@ -184,9 +184,9 @@ mod tests {
         assert!((s.nm[0] - nm[1]).abs() < 1e-9 && (s.nm[2] - nm[3]).abs() < 1e-9);
         let hero = Light::at_nm(nm[0]);
         let got = s.xyz(hero, 2.0);
-        for i in 0..3 {
+        for (i, g) in got.iter().enumerate() {
             let want = nm.iter().map(|&l| cmf_at(l)[i]).sum::<f64>() / 4.0 * 2.0;
-            assert!((got[i] - want).abs() < 1e-12, "{i}: {got:?}");
+            assert!((g - want).abs() < 1e-12, "{i}: {got:?}");
         }
         let mut ended = s;
         ended.end();
@@ -249,9 +249,9 @@ mod tests {
         };
         let got = s.xyz(hero, own(hero.nm()));
         let nm = [0.3, 0.55, 0.8, 0.05].map(flat);
-        for i in 0..3 {
+        for (i, g) in got.iter().enumerate() {
             let want = nm.iter().map(|&l| own(l) * cmf_at(l)[i]).sum::<f64>() / 4.0;
-            assert!((got[i] - want).abs() < 1e-12 * want.abs().max(1e-3), "{i}");
+            assert!((g - want).abs() < 1e-12 * want.abs().max(1e-3), "{i}");
         }
         assert!(s.largest_ratio() > 1.0);
     }

@@ -542,8 +542,7 @@ impl Sources {
             (Some(nm), _) => (Light::at_nm(nm), Secondaries::NONE),
             (None, Some(sp)) => {
                 let u = rng.uniform();
-                let others = Secondaries::stratified(u, |v| sp.sample(v));
-                (Light::at_nm(sp.sample(u)), others)
+                (Light::at_nm(sp.sample(u)), Secondaries::deferred(u, i))
             }
             (None, None) => (Light::MONOCHROME, Secondaries::NONE),
         };

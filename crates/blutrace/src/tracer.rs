@@ -130,12 +130,13 @@ impl<'a> Tracer<'a> {
     fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
         let e = self.scene.sources.sample(&mut rng);
+        let (light, secondaries) = self.wavelengths.of(&e, self.scene);
         let mut p = Photon {
             ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
             medium: e.medium,
             weight: 1.0,
-            light: self.wavelengths.light(&e),
-            secondaries: self.wavelengths.secondaries(&e),
+            light,
+            secondaries,
             pol: self
                 .scene
                 .polarized
@@ -179,8 +180,9 @@ impl<'a> Tracer<'a> {
             }
             if let Some((_, ab)) = detected {
                 let weight = p.light.detected(p.weight);
+                let secondaries = p.detected_secondaries(scene);
                 out.detections
-                    .push(detection(scene, ab, true_ray.dir, weight, p));
+                    .push(detection(scene, ab, true_ray.dir, weight, p, secondaries));
                 if let Some(pol) = &p.pol {
                     out.stokes.push(scene.detector.stokes_of(pol, true_ray.dir));
                 }
@@ -211,7 +213,7 @@ impl<'a> Tracer<'a> {
                     weight,
                 } => {
                     p.reweigh(weight, struck.sink(&mut out.ledger));
-                    p.scattered_by(model, feature, &scene.media, self.estimator);
+                    p.scattered_by(model, feature, scene, self.estimator);
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                     if p.pol.is_some() {
@@ -344,8 +346,8 @@ impl<'a> Tracer<'a> {
             let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
             let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
             match flight {
-                Flight::Reached => p.crossed(medium, t, self.estimator),
-                Flight::Scattered { t, .. } => p.crossed(medium, t, self.estimator),
+                Flight::Reached => p.crossed(p.medium, t, self.scene, self.estimator),
+                Flight::Scattered { t, .. } => p.crossed(p.medium, t, self.scene, self.estimator),
                 Flight::Absorbed => {}
             }
             if let Flight::Scattered { t, dir } = flight {
@@ -359,7 +361,7 @@ impl<'a> Tracer<'a> {
         if absorb_clear(p, medium.absorption(p.light), t, self.estimator, rng, sink) {
             Flight::Absorbed
         } else {
-            p.crossed(medium, t, self.estimator);
+            p.crossed(p.medium, t, self.scene, self.estimator);
             Flight::Reached
         }
     }
@@ -509,15 +511,23 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
     }
 }
 
-/// The detection of `p` (scoring `weight`) crossing the target at `ab` along `dir`.
-fn detection(scene: &Scene, ab: [f64; 2], dir: glam::DVec3, weight: f64, p: &Photon) -> Detection {
+/// The detection of `p` (scoring `weight`, its `secondaries` drawn) crossing the target
+/// at `ab` along `dir`.
+fn detection(
+    scene: &Scene,
+    ab: [f64; 2],
+    dir: glam::DVec3,
+    weight: f64,
+    p: &Photon,
+    secondaries: Secondaries,
+) -> Detection {
     let d = &scene.detector;
     Detection {
         flux_bin: d.flux_index(ab) as u32,
         angular_bin: d.angular_index(dir) as u32,
         weight,
         light: p.light,
-        secondaries: p.secondaries,
+        secondaries,
         in_cone: d.in_cone(dir),
     }
 }

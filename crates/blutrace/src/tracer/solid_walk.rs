@@ -150,7 +150,7 @@ impl Tracer<'_> {
             if absorb_clear(p, absorption, t, self.estimator, rng, sink) {
                 return Some(Fate::AbsorbedInMedium(medium));
             }
-            p.crossed(&scene.media[medium as usize], t, self.estimator);
+            p.crossed(medium, t, scene, self.estimator);
             let Some(h) = exit else {
                 return Some(Fate::Escaped);
             };
@@ -176,7 +176,7 @@ impl Tracer<'_> {
             };
             p.reweigh(weight, &mut out.ledger.absorbed_by_surface[tag as usize]);
             let model = &scene.surfaces[tag as usize];
-            p.scattered_by(model, feature, &scene.media, self.estimator);
+            p.scattered_by(model, feature, scene, self.estimator);
             ray = Ray::new(surf.point, dir);
             if !roulette(p, rng, &mut out.ledger) {
                 return Some(Fate::Roulette);
@@ -224,7 +224,7 @@ impl Tracer<'_> {
             if run.dispersive() {
                 p.secondaries.end();
             }
-            p.crossed(&self.scene.media[medium as usize], s.length, self.estimator);
+            p.crossed(medium, s.length, self.scene, self.estimator);
         }
         *events += s.events();
         out.ledger.plain_hits(run.plain_tag, s.plain_hits().into());

@@ -4,9 +4,10 @@
 //! only when the photon carries them (a monochrome scene never does).
 
 use super::Photon;
-use crate::optics::medium::{Interface, Medium};
+use crate::optics::medium::{Interface, Medium, MediumId};
 use crate::optics::spectrum::{Light, Secondaries, Spectral};
 use crate::optics::surface::{Estimator, Feature, SurfaceModel};
+use crate::scene::Scene;
 use crate::sources::Emission;
 
 /// Which wavelengths a photon of a spectral source carries.
@@ -26,20 +27,28 @@ pub(super) enum Carried {
 }
 
 impl Carried {
-    /// The light a photon of emission `e` is traced at.
-    pub(super) fn light(self, e: &Emission) -> Light {
+    /// The light a photon of emission `e` (in `scene`) is traced at, and the secondaries
+    /// it carries.
+    pub(super) fn of(self, e: &Emission, scene: &Scene) -> (Light, Secondaries) {
         match self {
-            Carried::Stratum(k) if k > 0 => e.secondaries.light(k - 1).unwrap_or(e.light),
-            _ => e.light,
+            Carried::Hero => (e.light, e.secondaries),
+            Carried::One | Carried::Stratum(0) => (e.light, Secondaries::NONE),
+            Carried::Stratum(k) => {
+                let mut s = e.secondaries;
+                draw(&mut s, scene);
+                (s.light(k - 1).unwrap_or(e.light), Secondaries::NONE)
+            }
         }
     }
+}
 
-    /// The secondaries it carries.
-    pub(super) fn secondaries(self, e: &Emission) -> Secondaries {
-        match self {
-            Carried::Hero => e.secondaries,
-            _ => Secondaries::NONE,
-        }
+/// Draw the wavelengths of `s` from its source's spectrum in `scene`, if not yet drawn.
+#[inline]
+fn draw(s: &mut Secondaries, scene: &Scene) {
+    if let Some(i) = s.undrawn() {
+        let spectrum = scene.sources.list[i].spectrum.as_ref();
+        let spectrum = spectrum.expect("secondaries come from a source's spectrum");
+        s.draw(|v| spectrum.sample(v));
     }
 }
 
@@ -88,33 +97,49 @@ fn surface_event<'m>(
 }
 
 impl Photon {
-    /// The hero was scattered by `model` (meeting its `feature`): its secondaries follow.
+    /// The hero was scattered by `model` (meeting its `feature`) in `scene`: its
+    /// secondaries follow.
     #[inline]
     pub(super) fn scattered_by(
         &mut self,
         model: &SurfaceModel,
         feature: Feature,
-        media: &[Medium],
+        scene: &Scene,
         estimator: Estimator,
     ) {
         if !self.secondaries.live() {
             return;
         }
-        match surface_event(model, feature, media) {
+        match surface_event(model, feature, &scene.media) {
             SurfaceEvent::Neutral => {}
-            SurfaceEvent::Albedo(q) => self.secondaries.survived(estimator, q, self.light),
+            SurfaceEvent::Albedo(q) if !q.is_spectral() => {}
+            SurfaceEvent::Albedo(q) => {
+                draw(&mut self.secondaries, scene);
+                self.secondaries.survived(estimator, q, self.light);
+            }
             SurfaceEvent::Splits => self.secondaries.end(),
         }
     }
 
-    /// The hero crossed `t` mm of `medium` (clear, or flew that far through a scattering
-    /// one without being absorbed): its secondaries' absorption there.
+    /// The hero crossed `t` mm of medium `m` of `scene` (clear, or flew that far through
+    /// a scattering one without being absorbed): its secondaries' absorption there.
     #[inline]
-    pub(super) fn crossed(&mut self, medium: &Medium, t: f64, estimator: Estimator) {
-        if self.secondaries.live() {
-            let a = &medium.absorption_per_mm;
+    pub(super) fn crossed(&mut self, m: MediumId, t: f64, scene: &Scene, estimator: Estimator) {
+        if !self.secondaries.live() {
+            return;
+        }
+        let a = &scene.media[m as usize].absorption_per_mm;
+        if a.is_spectral() {
+            draw(&mut self.secondaries, scene);
             self.secondaries.crossed(estimator, a, self.light, t);
         }
+    }
+
+    /// Its secondaries as a detection scores them (their wavelengths drawn).
+    #[inline]
+    pub(super) fn detected_secondaries(&mut self, scene: &Scene) -> Secondaries {
+        draw(&mut self.secondaries, scene);
+        self.secondaries
     }
 
     /// The hero is about to fly through scattering `medium`: a free path or phase

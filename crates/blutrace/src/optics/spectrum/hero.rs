@@ -48,8 +48,14 @@ pub struct Secondaries {
     weight: [f64; SECONDARIES],
     /// The probability of the path's decisions had each been the hero, over the hero's.
     pdf: [f64; SECONDARIES],
-    /// Whether they are carried at all.
+    /// The hero's cumulative fraction in its source's spectrum, and that source: the
+    /// wavelengths are drawn from them when first read ([`Secondaries::draw`]), so a
+    /// photon whose secondaries end before any spectral event never draws them.
+    u: f64,
+    source: u32,
+    /// Whether they are carried at all, and whether their wavelengths are drawn.
     live: bool,
+    drawn: bool,
 }
 
 impl Secondaries {
@@ -58,23 +64,48 @@ impl Secondaries {
         nm: [0.0; SECONDARIES],
         weight: [0.0; SECONDARIES],
         pdf: [0.0; SECONDARIES],
+        u: 0.0,
+        source: 0,
         live: false,
+        drawn: false,
     };
+
+    /// The secondaries of a hero drawn at cumulative fraction `u` of the spectrum of
+    /// source `source`, their wavelengths not drawn yet.
+    pub fn deferred(u: f64, source: usize) -> Secondaries {
+        Secondaries {
+            weight: [1.0; SECONDARIES],
+            pdf: [1.0; SECONDARIES],
+            u,
+            source: source as u32,
+            live: true,
+            ..Secondaries::NONE
+        }
+    }
+
+    /// The source whose spectrum their wavelengths are still to be drawn from.
+    #[inline(always)]
+    pub fn undrawn(&self) -> Option<usize> {
+        (self.live && !self.drawn).then_some(self.source as usize)
+    }
+
+    /// Draw their wavelengths from the inverse cumulative `sample` of their source's
+    /// spectrum: at `u + k / WAVELENGTHS` (mod 1), one per stratum.
+    pub fn draw(&mut self, sample: impl Fn(f64) -> f64) {
+        self.nm = std::array::from_fn(|k| {
+            let v = self.u + (k + 1) as f64 / WAVELENGTHS as f64;
+            sample(if v >= 1.0 { v - 1.0 } else { v })
+        });
+        self.drawn = true;
+    }
 
     /// The secondaries of a hero drawn at cumulative fraction `u` of a spectrum whose
     /// inverse cumulative is `sample`: the wavelengths at `u + k / WAVELENGTHS` (mod 1),
     /// one per stratum.
     pub fn stratified(u: f64, sample: impl Fn(f64) -> f64) -> Secondaries {
-        let nm = std::array::from_fn(|k| {
-            let v = u + (k + 1) as f64 / WAVELENGTHS as f64;
-            sample(if v >= 1.0 { v - 1.0 } else { v })
-        });
-        Secondaries {
-            nm,
-            weight: [1.0; SECONDARIES],
-            pdf: [1.0; SECONDARIES],
-            live: true,
-        }
+        let mut s = Secondaries::deferred(u, 0);
+        s.draw(sample);
+        s
     }
 
     /// Whether the photon carries them.
@@ -91,7 +122,7 @@ impl Secondaries {
 
     /// The light of the `k`-th (from 0), if they are carried.
     pub fn light(&self, k: usize) -> Option<Light> {
-        (self.live && k < SECONDARIES).then(|| Light::at_nm(self.nm[k]))
+        (self.live && self.drawn && k < SECONDARIES).then(|| Light::at_nm(self.nm[k]))
     }
 
     /// Their lights.
@@ -100,11 +131,12 @@ impl Secondaries {
     }
 
     /// The hero survived an event of probability (analog) or factor (weighted) `q`, read
-    /// at the hero's `hero` light (positive: it survived).
+    /// at the hero's `hero` light (positive: it survived). Drawn first.
     pub fn survived(&mut self, estimator: Estimator, q: &Spectral, hero: Light) {
         if !q.is_spectral() {
             return;
         }
+        debug_assert!(self.drawn);
         let qh = q.at(hero);
         for k in 0..SECONDARIES {
             let qk = q.at(Light::at_nm(self.nm[k]));
@@ -120,10 +152,12 @@ impl Secondaries {
     /// The hero crossed `t` mm of a medium absorbing `a` per mm (its light `hero`) and
     /// was not absorbed (analog), or was attenuated by `exp(-a t)` (weighted). A photon
     /// that leaves to infinity in an absorbing medium is absorbed there: they end.
+    /// Drawn first.
     pub fn crossed(&mut self, estimator: Estimator, a: &Spectral, hero: Light, t: f64) {
         if !a.is_spectral() {
             return;
         }
+        debug_assert!(self.drawn);
         if !t.is_finite() {
             self.end();
             return;
@@ -140,12 +174,16 @@ impl Secondaries {
 
     /// X, Y, Z a detection of hero `hero` and weight `weight` scores: each wavelength's
     /// x̄, ȳ, z̄ times its throughput, over the mean of the decisions' probabilities
-    /// (the hero's alone, `weight` x̄(λₕ) ..., when there are none).
+    /// (the hero's alone, `weight` x̄(λₕ) ..., when there are none). Drawn first.
     pub fn xyz(&self, hero: Light, weight: f64) -> [f64; 3] {
         let h = cmf_at(hero.nm());
         if !self.live {
             return h.map(|c| c * weight);
         }
+        assert!(
+            self.drawn,
+            "secondaries scored before their wavelengths were drawn"
+        );
         let mut sum = h;
         for (l, w) in self.lights().zip(self.weight) {
             let c = cmf_at(l.nm());

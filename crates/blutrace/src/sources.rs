@@ -30,7 +30,7 @@ pub mod spectrum;
 use crate::geometry::Ray;
 use crate::optics::medium::{Medium, MediumId, medium_id};
 use crate::optics::polarization::Polarization;
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
 use anyhow::Result;
@@ -423,11 +423,13 @@ pub struct Emission {
     pub medium: MediumId,
     /// The index of the source that emitted it.
     pub source: usize,
-    /// Its light (see [`crate::optics::spectrum`]).
+    /// Its light (see [`crate::optics::spectrum`]): the hero wavelength...
     pub light: Light,
     /// Its polarization when its emitter gives it (a ray file's Stokes columns), else
     /// the source's `polarization`, if any, gives it.
     pub pol: Option<Polarization>,
+    /// ...and the others it carries along the hero's path.
+    pub secondaries: Secondaries,
 }
 
 impl Source {
@@ -547,10 +549,13 @@ impl Sources {
             .min(self.list.len() - 1);
         let s = &self.list[i];
         let (ray, normal, own_nm, pol) = s.emitter.emit_own(rng);
-        let light = match (own_nm, &s.spectrum) {
-            (Some(nm), _) => Light::at_nm(nm),
-            (None, Some(sp)) => Light::at_nm(sp.sample(rng.uniform())),
-            (None, None) => Light::MONOCHROME,
+        let (light, secondaries) = match (own_nm, &s.spectrum) {
+            (Some(nm), _) => (Light::at_nm(nm), Secondaries::NONE),
+            (None, Some(sp)) => {
+                let u = rng.uniform();
+                (Light::at_nm(sp.sample(u)), Secondaries::deferred(u, i))
+            }
+            (None, None) => (Light::MONOCHROME, Secondaries::NONE),
         };
         Emission {
             ray,
@@ -559,6 +564,7 @@ impl Sources {
             source: i,
             light,
             pol,
+            secondaries,
         }
     }
 

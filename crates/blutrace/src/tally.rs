@@ -11,7 +11,7 @@
 pub mod color;
 pub mod meter;
 
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::optics::surface::MediumId;
 use crate::scene::Scene;
 pub use color::{ColorTally, ScoredXyz};
@@ -729,8 +729,10 @@ pub struct Detection {
     pub angular_bin: u32,
     /// Photon weight at detection.
     pub weight: f64,
-    /// The photon's light (its wavelength, for the colour tallies).
+    /// The photon's light (its hero wavelength, for the colour tallies)...
     pub light: Light,
+    /// ...and the other wavelengths it carried ([`Secondaries::xyz`] scores them).
+    pub secondaries: Secondaries,
 }
 
 /// What one chunk of photons scored: a list of detections (cheap to ship between

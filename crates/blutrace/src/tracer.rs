@@ -21,6 +21,7 @@ mod body_boxes;
 mod flight;
 mod meter;
 mod solid_walk;
+mod spectral;
 mod tir_run;
 
 use crate::accel::Accel;
@@ -30,7 +31,7 @@ use crate::geometry::{Facet, Ray, SpawnedRay, SurfaceHit};
 use crate::optics::absorber::Absorber;
 use crate::optics::model::Arrival;
 use crate::optics::polarization::Polarization;
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::optics::two_sided;
 use crate::rng::PhotonRng;
@@ -76,6 +77,8 @@ pub struct Tracer<'a> {
     bodies: BodyBoxes,
     /// How the luminance maps are estimated ([`meter`]); `None`: the scene has none.
     luminance: Option<LuminanceEstimator>,
+    /// Which wavelengths photons of spectral sources carry ([`spectral`]).
+    wavelengths: spectral::Carried,
 }
 
 /// A photon in flight.
@@ -84,8 +87,10 @@ struct Photon {
     ray: SpawnedRay,
     medium: MediumId,
     weight: f64,
-    /// Its light, drawn with its emission: what it meets is read at it.
+    /// Its light, drawn with its emission: what it meets is read at it (the hero)...
     light: Light,
+    /// ...and the other wavelengths it carries along ([`spectral`]).
+    secondaries: Secondaries,
     /// Its polarization, when the scene traces it.
     pol: Option<Polarization>,
     /// Analog estimator: the optical depth of clear-medium absorption the photon has
@@ -135,6 +140,7 @@ impl<'a> Tracer<'a> {
             walks: Walks::new(scene, convex, &bodies),
             bodies,
             luminance: scene.luminous().then_some(LuminanceEstimator::Cone),
+            wavelengths: spectral::Carried::Hero,
         }
     }
 
@@ -151,11 +157,13 @@ impl<'a> Tracer<'a> {
     fn trace_photon(&self, seed: u64, index: u64, out: &mut ChunkTally) {
         let mut rng = PhotonRng::new(seed, index);
         let e = self.scene.sources.sample(&mut rng);
+        let (light, secondaries) = self.wavelengths.of(&e, self.scene);
         let mut p = Photon {
             ray: SpawnedRay::leaving(e.ray.origin, e.normal, e.ray.dir, self.scene.spawn_eps),
             medium: e.medium,
             weight: 1.0,
-            light: e.light,
+            light,
+            secondaries,
             pol: self
                 .scene
                 .polarized
@@ -215,9 +223,10 @@ impl<'a> Tracer<'a> {
                         .push(scene.detector.stokes_of(&pol, true_ray.dir));
                 }
                 let weight = p.light.detected(p.weight);
+                let secondaries = p.detected_secondaries(scene);
                 out.detections
-                    .push(detection(scene, ab, true_ray.dir, weight, p.light));
-                self.count_in_cones(p, (ab, true_ray.dir), weight, out);
+                    .push(detection(scene, ab, true_ray.dir, weight, p, secondaries));
+                self.count_in_cones(p, (ab, true_ray.dir), (weight, &secondaries), out);
                 return Fate::Detected;
             }
             let Some(Hit { surf, struck }) = surf else {
@@ -256,6 +265,7 @@ impl<'a> Tracer<'a> {
                     weight,
                 } => {
                     p.reweigh(weight, struck.sink(&mut out.ledger));
+                    p.scattered_by(model, feature, scene, self.estimator);
                     p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                     if p.pol.is_some() {
@@ -278,7 +288,7 @@ impl<'a> Tracer<'a> {
         &self,
         p: &Photon,
         (ab, dir): ([f64; 2], glam::DVec3),
-        weight: f64,
+        (weight, secondaries): (f64, &Secondaries),
         out: &mut ChunkTally,
     ) {
         let Some(mode) = self.luminance else {
@@ -290,12 +300,9 @@ impl<'a> Tracer<'a> {
         let d = &self.scene.detector;
         let cones = d.cones_holding(dir);
         for k in (0..d.views.len()).filter(|k| cones >> k & 1 == 1) {
-            out.meter.push(MeterHit {
-                view: k as u16,
-                flux_bin: d.flux_index(ab) as u32,
-                weight,
-                light: p.light,
-            });
+            let spectral = self.scene.sources.spectral().then_some(secondaries);
+            let at = (k as u16, d.flux_index(ab) as u32);
+            out.meter.push(MeterHit::new(at, weight, p.light, spectral));
             let cause = match (p.covered, p.turned) {
                 (false, _) => p.cause,
                 (true, u32::MAX) => Cause::TurnedInWalk.index(self.places()),
@@ -423,8 +430,14 @@ impl<'a> Tracer<'a> {
         let sink = &mut ledger.absorbed_in_medium[p.medium as usize];
         if medium.scattering.scatters() {
             let eps = self.scene.spawn_eps;
+            p.enters_scattering(medium);
             let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
             let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
+            match flight {
+                Flight::Reached => p.crossed(p.medium, t, self.scene, self.estimator),
+                Flight::Scattered { t, .. } => p.crossed(p.medium, t, self.scene, self.estimator),
+                Flight::Absorbed => {}
+            }
             if let Flight::Scattered { t, dir } = flight {
                 // Inside the medium, clear of surfaces: the search needs no nudge.
                 p.ray = SpawnedRay::unnudged(Ray::new(true_ray.at(t), dir));
@@ -436,6 +449,7 @@ impl<'a> Tracer<'a> {
         if absorb_clear(p, medium.absorption(p.light), t, self.estimator, rng, sink) {
             Flight::Absorbed
         } else {
+            p.crossed(p.medium, t, self.scene, self.estimator);
             Flight::Reached
         }
     }
@@ -601,19 +615,23 @@ fn roulette(p: &mut Photon, rng: &mut PhotonRng, ledger: &mut Ledger) -> bool {
     }
 }
 
+/// The detection of `p` (scoring `weight`, its `secondaries` drawn) crossing the target
+/// at `ab` along `dir`.
 fn detection(
     scene: &Scene,
     ab: [f64; 2],
     dir: glam::DVec3,
     weight: f64,
-    light: Light,
+    p: &Photon,
+    secondaries: Secondaries,
 ) -> Detection {
     let d = &scene.detector;
     Detection {
         flux_bin: d.flux_index(ab) as u32,
         angular_bin: d.angular_index(dir) as u32,
         weight,
-        light,
+        light: p.light,
+        secondaries,
     }
 }
 

@@ -152,6 +152,14 @@ impl Surface for Polarizer {
 }
 
 impl Polarizer {
+    /// Whether a transmittance or reflectance varies with wavelength (then which way the
+    /// light goes does too).
+    pub fn is_spectral(&self) -> bool {
+        [&self.pass.0, &self.pass.1, &self.block.0, &self.block.1]
+            .iter()
+            .any(|q| q.is_spectral())
+    }
+
     /// The block axis on a face of unit normal `normal`: the face-plane direction across
     /// the pass axis.
     fn block_axis(&self, normal: DVec3) -> DVec3 {

@@ -2,13 +2,13 @@
 //! tallied beside the radiant weights when the scene's sources have spectra.
 //!
 //! A detected photon of weight w and wavelength λ scores w x̄(λ), w ȳ(λ), w z̄(λ) (the
-//! 2-degree observer, [`crate::sources::spectrum::cmf_at`]); sampling λ from the sources'
-//! spectra makes the sums unbiased estimates of ∫ E(λ) x̄(λ) dλ etc. per unit radiant
-//! power. Like every tally they are exact fixed-point sums with per-photon sums of
+//! 2-degree observer, [`crate::sources::spectrum::cmf_at`]); one that carried several
+//! wavelengths scores them all, each by its own throughput
+//! ([`crate::optics::spectrum::Secondaries::xyz`]). Sampling λ from the sources' spectra
+//! makes the sums unbiased estimates of ∫ E(λ) x̄(λ) dλ etc. per unit radiant power. Like every tally they are exact fixed-point sums with per-photon sums of
 //! squares, so they merge, split and shard as the radiant ones do.
 
 use super::{BinStats, Detection, Grid, Sign};
-use crate::sources::spectrum::cmf_at;
 use serde::{Deserialize, Serialize};
 
 /// X, Y, Z per flux bin and per angular bin.
@@ -38,10 +38,10 @@ impl ColorTally {
         detections
             .iter()
             .map(|d| {
-                let cmf = cmf_at(d.light.nm());
+                let xyz = d.secondaries.xyz(d.light, d.weight);
                 std::array::from_fn(|k| {
                     let mut one = BinStats::default();
-                    one.add(d.weight * cmf[k]);
+                    one.add(xyz[k]);
                     one
                 })
             })

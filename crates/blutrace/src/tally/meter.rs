@@ -8,8 +8,7 @@
 //! tally's is ([`super::BinStats`]), and its errors stay right though one photon scores a bin many times.
 
 use super::{ExactSum, Grid, Sign};
-use crate::optics::spectrum::Light;
-use crate::sources::spectrum::cmf_at;
+use crate::optics::spectrum::{Light, Secondaries};
 use serde::{Deserialize, Serialize};
 
 /// Per view, the meter's grids: one (the luminous weight) or, in a spectral run, X, Y, Z.
@@ -56,8 +55,28 @@ pub struct MeterHit {
     pub flux_bin: u32,
     /// Weight in cone-count units (a photon of this weight leaving within the cone).
     pub weight: f64,
-    /// The light (its wavelength, for X, Y, Z).
-    pub light: Light,
+    /// Its X, Y, Z (the weight times the colour matching functions at the wavelengths
+    /// it carries), in a spectral run.
+    pub xyz: [f64; 3],
+}
+
+impl MeterHit {
+    /// The hit of `weight` in `view` and `flux_bin` of light `light` that carries the
+    /// wavelengths `secondaries` in a spectral run (`None`: a monochrome one).
+    pub fn new(
+        (view, flux_bin): (u16, u32),
+        weight: f64,
+        light: Light,
+        secondaries: Option<&Secondaries>,
+    ) -> MeterHit {
+        let xyz = secondaries.map_or([0.0; 3], |s| s.xyz(light, weight));
+        MeterHit {
+            view,
+            flux_bin,
+            weight,
+            xyz,
+        }
+    }
 }
 
 impl MeterTally {
@@ -98,9 +117,8 @@ impl MeterTally {
             let grids = &mut self.views[h.view as usize];
             let bin = h.flux_bin as usize;
             if grids.len() == 3 {
-                let cmf = cmf_at(h.light.nm());
-                for (g, c) in grids.iter_mut().zip(cmf) {
-                    g.bins[bin].add(h.weight * c);
+                for (g, c) in grids.iter_mut().zip(h.xyz) {
+                    g.bins[bin].add(c);
                 }
             } else {
                 grids[0].bins[bin].add(h.weight);
@@ -186,6 +204,7 @@ pub fn merge_photon_hits(hits: &mut Vec<MeterHit>, from: usize) {
         let (k, h) = (kept, hits[i]);
         if (hits[k].view, hits[k].flux_bin) == (h.view, h.flux_bin) {
             hits[k].weight += h.weight;
+            (0..3).for_each(|c| hits[k].xyz[c] += h.xyz[c]);
         } else {
             kept += 1;
             hits[kept] = h;
@@ -203,7 +222,7 @@ mod tests {
             view,
             flux_bin,
             weight,
-            light: Light::MONOCHROME,
+            xyz: [weight, 2.0 * weight, 3.0 * weight],
         }
     }
 
@@ -228,11 +247,14 @@ mod tests {
     fn spectral_views_keep_xyz() {
         let mut t = MeterTally::new(2, (2, 1), true, 0);
         t.absorb(&[hit(1, 1, 2.0)], ExactSum::default(), &[]);
-        let cmf = cmf_at(Light::MONOCHROME.nm());
         let [x, y, z] = t.xyz(1).unwrap();
+        assert_eq!((x.bins[1].sum.value(), y.bins[1].sum.value()), (2.0, 4.0));
+        let one = MeterHit::new((0, 1), 2.0, Light::at_nm(555.0), Some(&Secondaries::NONE));
+        let cmf = crate::sources::spectrum::cmf_at(555.0);
+        assert_eq!(one.xyz, cmf.map(|c| 2.0 * c));
         assert_eq!(
-            x.bins[1].sum.value(),
-            (2.0 * cmf[0] * 2f64.powi(64)).round() / 2f64.powi(64)
+            MeterHit::new((0, 1), 2.0, Light::MONOCHROME, None).xyz,
+            [0.0; 3]
         );
         assert_eq!(t.luminous(1), y);
         assert!(z.bins[1].hits == 1 && t.luminous(0).bins[1].hits == 0);

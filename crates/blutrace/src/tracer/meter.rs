@@ -50,7 +50,7 @@ use crate::geometry::SpawnedRay;
 use crate::optics::model::{Arrival, MeterVertex};
 use crate::optics::polarization::Polarization;
 use crate::optics::sampling;
-use crate::optics::spectrum::Light;
+use crate::optics::spectrum::{Light, Secondaries};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
 use crate::tally::{ChunkTally, MeterHit};
@@ -229,12 +229,11 @@ impl Tracer<'_> {
                 }
                 if let Some((bin, throughput)) = self.peel_path(v.at, dir, out, rng) {
                     let cosines = out.dot(normal) / dir.dot(normal).abs();
-                    hits.push(MeterHit {
-                        view: k as u16,
-                        flux_bin: bin,
-                        weight: v.weight * density * throughput * cosines * jacobian,
-                        light,
-                    });
+                    // The hero's wavelength alone: the peel-off path is the hero's (its
+                    // secondaries' own weights are not carried along it).
+                    let w = v.weight * density * throughput * cosines * jacobian;
+                    let spectral = self.scene.sources.spectral().then_some(&Secondaries::NONE);
+                    hits.push(MeterHit::new((k as u16, bin), w, light, spectral));
                 }
             }
         }
@@ -263,6 +262,7 @@ impl Tracer<'_> {
             cause: 0,
             turned: u32::MAX,
             peel_rng: None,
+            secondaries: Secondaries::NONE,
         };
         for _ in 0..PEEL_EVENTS {
             let true_ray = p.ray.true_ray();

@@ -150,6 +150,7 @@ impl Tracer<'_> {
             if absorb_clear(p, absorption, t, self.estimator, rng, sink) {
                 return Some(Fate::AbsorbedInMedium(medium));
             }
+            p.crossed(medium, t, scene, self.estimator);
             let Some(h) = exit else {
                 return Some(Fate::Escaped);
             };
@@ -187,6 +188,8 @@ impl Tracer<'_> {
                 return Some(Fate::AbsorbedBySurface(tag));
             };
             p.reweigh(weight, &mut out.ledger.absorbed_by_surface[tag as usize]);
+            let model = &scene.surfaces[tag as usize];
+            p.scattered_by(model, feature, scene, self.estimator);
             ray = Ray::new(surf.point, dir);
             if !roulette(p, rng, &mut out.ledger) {
                 return Some(Fate::Roulette);
@@ -229,6 +232,12 @@ impl Tracer<'_> {
         };
         if let Some(pol) = &mut p.pol {
             run.retard(pol, dir, &s, p.light);
+        }
+        if p.secondaries.live() {
+            if run.dispersive() {
+                p.secondaries.end();
+            }
+            p.crossed(medium, s.length, self.scene, self.estimator);
         }
         *events += s.events();
         out.ledger.plain_hits(run.plain_tag, s.plain_hits().into());

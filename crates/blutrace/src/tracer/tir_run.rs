@@ -227,6 +227,15 @@ impl<'a> TirRun<'a> {
         })
     }
 
+    /// Whether an index either side of a face varies with wavelength (then total
+    /// reflection does too: a photon's secondary wavelengths end at a run).
+    pub(super) fn dispersive(&self) -> bool {
+        self.plain_n
+            .iter()
+            .chain(&self.dotted_n)
+            .any(Spectral::is_spectral)
+    }
+
     /// Both faces reflect totally at incidence cosine `cos` (`fresnel::roulette`'s test).
     fn reflects(&self, cos: f64, light: Light) -> bool {
         let tir = |[n1, n2]: &[Spectral; 2]| {

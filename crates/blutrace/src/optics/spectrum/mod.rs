@@ -26,7 +26,13 @@
 //! reflectance and albedo of the surface models (lambert `albedo`, dots `ink_albedo`,
 //! mirror and phong `reflectance`) and the weight a detection scores ([`Light::detected`]).
 //! A photon of a monochrome scene (no source spectrum) carries [`Light::MONOCHROME`], and
-//! a table in such a scene is read at its wavelength.
+//! a table in such a scene is read at its wavelength. A photon of a spectral source
+//! carries [`WAVELENGTHS`] wavelengths along one path: [`Light`] is its hero, and the
+//! others ride along as [`Secondaries`] (hero-wavelength sampling, `hero`).
+
+mod hero;
+
+pub use hero::{Secondaries, WAVELENGTHS};
 
 use crate::color::cie_cmf::{CMF_FIRST_NM, CMF_STEP_NM};
 use crate::spec_check::{Ctx, short};

@@ -51,7 +51,7 @@ enum Command {
     /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback), or any
     /// numbers of the scene file (`--vary`).
     Optimize(Box<optimize::OptimizeArgs>),
-    /// Measure photons/s per backend (ratios in one run; see the README's table).
+    /// Measure photons/s per backend (ratios in one run; see the book's Performance and backends page).
     Bench {
         /// Photons per configuration.
         #[arg(long, default_value_t = 200_000, value_parser = blutrace::count::parse_photons)]

@@ -1,4 +1,4 @@
-"""The README's Python example runs as printed (scene paths made absolute, run elsewhere)."""
+"""The book's Python example runs as printed (scene paths made absolute, run elsewhere)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import sys
 from conftest import REPO
 
 
-def test_the_readmes_python_example_runs(tmp_path):
-    readme = (REPO / "README.md").read_text()
-    section = readme.split("## From Python", 1)[1]
+def test_the_books_python_example_runs(tmp_path):
+    page = (REPO / "docs/book/src/python.md").read_text()
+    section = page.split("# From Python", 1)[1]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     code = code.replace('"scenes/', f'"{REPO}/scenes/')
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)

@@ -34,7 +34,11 @@ fn broken_links(pages: &[PathBuf]) -> Vec<String> {
     let mut broken = Vec::new();
     for page in pages {
         let (_, prose) = split(&std::fs::read_to_string(page).unwrap());
-        let name = page.strip_prefix(repo()).unwrap_or(page).display().to_string();
+        let name = page
+            .strip_prefix(repo())
+            .unwrap_or(page)
+            .display()
+            .to_string();
         for (line, target) in links(&prose) {
             if target.contains("://") || target.starts_with("mailto:") {
                 continue;
@@ -55,8 +59,12 @@ fn broken_links(pages: &[PathBuf]) -> Vec<String> {
             if let Some(anchor) = anchor {
                 match anchors_of.get(&resolved) {
                     Some(known) if known.iter().any(|a| a == anchor) => {}
-                    Some(_) => broken.push(format!("{name}:{line}: {target}: no heading #{anchor}")),
-                    None => broken.push(format!("{name}:{line}: {target}: an anchor into a non-page")),
+                    Some(_) => {
+                        broken.push(format!("{name}:{line}: {target}: no heading #{anchor}"))
+                    }
+                    None => broken.push(format!(
+                        "{name}:{line}: {target}: an anchor into a non-page"
+                    )),
                 }
             }
         }
@@ -67,7 +75,10 @@ fn broken_links(pages: &[PathBuf]) -> Vec<String> {
 #[test]
 fn every_link_of_the_book_and_the_readme_resolves() {
     let pages = pages();
-    assert!(pages.len() > 20, "the book's pages were not found: {pages:?}");
+    assert!(
+        pages.len() > 20,
+        "the book's pages were not found: {pages:?}"
+    );
     let broken = broken_links(&pages);
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
 }
@@ -87,7 +98,10 @@ fn a_broken_link_or_anchor_is_found() {
     let broken = broken_links(&pages);
     assert_eq!(broken.len(), 2, "{broken:?}");
     assert!(broken[0].ends_with(":4: c.md: no such file"), "{broken:?}");
-    assert!(broken[1].ends_with(":5: b.md#title-2: no heading #title-2"), "{broken:?}");
+    assert!(
+        broken[1].ends_with(":5: b.md#title-2: no heading #title-2"),
+        "{broken:?}"
+    );
 }
 
 #[test]
@@ -95,7 +109,10 @@ fn every_page_is_in_the_table_of_contents() {
     let src = repo().join(BOOK_SRC);
     let summary = std::fs::read_to_string(src.join("SUMMARY.md")).unwrap();
     let (_, prose) = split(&summary);
-    let listed: Vec<PathBuf> = links(&prose).into_iter().map(|(_, t)| src.join(t)).collect();
+    let listed: Vec<PathBuf> = links(&prose)
+        .into_iter()
+        .map(|(_, t)| src.join(t))
+        .collect();
     let missing: Vec<_> = pages()
         .into_iter()
         .filter(|p| p.starts_with(&src) && !p.ends_with("SUMMARY.md") && !listed.contains(p))
@@ -107,11 +124,24 @@ fn every_page_is_in_the_table_of_contents() {
 fn the_readme_stays_short_and_points_into_the_book() {
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
     let lines = readme.lines().count();
-    assert!(lines <= 250, "README.md has {lines} lines; the book is for the rest");
+    assert!(
+        lines <= 250,
+        "README.md has {lines} lines; the book is for the rest"
+    );
     let (_, prose) = split(&readme);
-    let into_book = links(&prose).iter().filter(|(_, t)| t.starts_with("docs/book/src/")).count();
-    assert!(into_book >= 10, "the README links {into_book} times into the book");
-    for needed in ["cargo run --release -- trace scenes/notebook14", "bash tools/test.sh", "-- --ignored"] {
+    let into_book = links(&prose)
+        .iter()
+        .filter(|(_, t)| t.starts_with("docs/book/src/"))
+        .count();
+    assert!(
+        into_book >= 10,
+        "the README links {into_book} times into the book"
+    );
+    for needed in [
+        "cargo run --release -- trace scenes/notebook14",
+        "bash tools/test.sh",
+        "-- --ignored",
+    ] {
         assert!(readme.contains(needed), "the README lost `{needed}`");
     }
 }

@@ -11,6 +11,9 @@
 //!   detector, trace and opaque surfaces that names no file is also spliced into
 //!   `scenes/bench-box` (an opaque surface onto its `reflector_sheet`) and loaded with every
 //!   check;
+//! - every whole scene validates against the scene file's JSON Schema (`blutrace schema`),
+//!   and every table of a fragment (completed where it elides keys) against the schema of
+//!   its kind;
 //! - a block that shows every table of a scene at once rather than one backlight says so
 //!   with `<!-- book_snippets: tables -->` on the line before its fence, and is read as a
 //!   fragment.
@@ -22,6 +25,7 @@ use blutrace::scene::Scene;
 use blutrace::scene::config::{
     DetectorSpec, GeometrySpec, MediumSpec, ProceduralSpec, SourceSpec, SurfaceEntry, TraceSpec,
 };
+use blutrace::scene::schema::scene_schema;
 use markdown::{pages, repo, split};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -44,7 +48,11 @@ struct Snippet {
 fn snippets_of(page: &Path) -> Vec<Snippet> {
     let text = std::fs::read_to_string(page).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    let name = page.strip_prefix(repo()).unwrap_or(page).display().to_string();
+    let name = page
+        .strip_prefix(repo())
+        .unwrap_or(page)
+        .display()
+        .to_string();
     let (blocks, _) = split(&text);
     blocks
         .into_iter()
@@ -63,7 +71,12 @@ fn read_toml(path: &str) -> Table {
 
 /// A bundled scene's first source of `kind`, to lay an elided fragment over.
 fn base_source(kind: &str) -> Option<Table> {
-    ["scenes/bench-box/scene.toml", "scenes/notebook14/scene.toml"].iter().find_map(|scene| {
+    [
+        "scenes/bench-box/scene.toml",
+        "scenes/notebook14/scene.toml",
+    ]
+    .iter()
+    .find_map(|scene| {
         read_toml(scene)["sources"]
             .as_array()
             .unwrap()
@@ -90,7 +103,10 @@ fn completed(over: &Table, base: Option<Table>, elided: bool) -> Table {
 }
 
 fn typed<T: serde::de::DeserializeOwned>(value: &Value, what: &str) -> Result<T, String> {
-    value.clone().try_into::<T>().map_err(|e| format!("{what}: {e}"))
+    value
+        .clone()
+        .try_into::<T>()
+        .map_err(|e| format!("{what}: {e}"))
 }
 
 /// Reads each table of a fragment with the loader's spec type; returns the tables with
@@ -106,7 +122,12 @@ fn read_tables(doc: &Table, elided: bool) -> Result<Table, String> {
             "surfaces" => drop(typed::<BTreeMap<String, SurfaceEntry>>(value, key)?),
             "sources" => {
                 let mut sources = Vec::new();
-                for (i, s) in value.as_array().ok_or("sources: not an array")?.iter().enumerate() {
+                for (i, s) in value
+                    .as_array()
+                    .ok_or("sources: not an array")?
+                    .iter()
+                    .enumerate()
+                {
                     let s = s.as_table().ok_or("sources: not tables")?;
                     let kind = s.get("type").and_then(Value::as_str).unwrap_or("");
                     let s = completed(s, base_source(kind), elided);
@@ -116,8 +137,14 @@ fn read_tables(doc: &Table, elided: bool) -> Result<Table, String> {
                 done.insert(key.clone(), Value::Array(sources));
             }
             "detector" => {
-                let base = read_toml(&format!("{BASE}/scene.toml"))["detector"].as_table().cloned();
-                let d = completed(value.as_table().ok_or("detector: not a table")?, base, elided);
+                let base = read_toml(&format!("{BASE}/scene.toml"))["detector"]
+                    .as_table()
+                    .cloned();
+                let d = completed(
+                    value.as_table().ok_or("detector: not a table")?,
+                    base,
+                    elided,
+                );
                 typed::<DetectorSpec>(&Value::Table(d.clone()), key)?;
                 done.insert(key.clone(), Value::Table(d));
             }
@@ -130,7 +157,9 @@ fn read_tables(doc: &Table, elided: bool) -> Result<Table, String> {
 
 fn names_a_file(value: &Value) -> bool {
     match value {
-        Value::Table(t) => t.iter().any(|(k, v)| FILE_KEYS.contains(&k.as_str()) || names_a_file(v)),
+        Value::Table(t) => t
+            .iter()
+            .any(|(k, v)| FILE_KEYS.contains(&k.as_str()) || names_a_file(v)),
         Value::Array(a) => a.iter().any(names_a_file),
         _ => false,
     }
@@ -150,7 +179,10 @@ fn spliced(doc: &Table) -> Option<Table> {
                 base.insert(key.clone(), value.clone());
             }
             "detector" | "trace" => {
-                let merged = overlay(base[key].as_table().cloned().unwrap_or_default(), value.as_table()?);
+                let merged = overlay(
+                    base[key].as_table().cloned().unwrap_or_default(),
+                    value.as_table()?,
+                );
                 base.insert(key.clone(), Value::Table(merged));
             }
             "media" => {
@@ -161,12 +193,16 @@ fn spliced(doc: &Table) -> Option<Table> {
             }
             "surfaces" => {
                 let tables = value.as_table()?;
-                let [(_, surface)] = tables.iter().collect::<Vec<_>>()[..] else { return None };
+                let [(_, surface)] = tables.iter().collect::<Vec<_>>()[..] else {
+                    return None;
+                };
                 let model = surface.get("model")?.as_str()?;
                 if !OPAQUE.contains(&model) {
                     return None;
                 }
-                base["surfaces"].as_table_mut()?.insert("reflector_sheet".into(), surface.clone());
+                base["surfaces"]
+                    .as_table_mut()?
+                    .insert("reflector_sheet".into(), surface.clone());
             }
             _ => return None,
         }
@@ -175,7 +211,9 @@ fn spliced(doc: &Table) -> Option<Table> {
 }
 
 fn is_whole(doc: &Table) -> bool {
-    ["version", "surfaces", "sources", "detector"].iter().all(|k| doc.contains_key(*k))
+    ["version", "surfaces", "sources", "detector"]
+        .iter()
+        .all(|k| doc.contains_key(*k))
 }
 
 /// The bundled scene folder holding every file a whole scene names (geometry), if any.
@@ -183,7 +221,11 @@ fn folder_for(doc: &Table) -> Option<std::path::PathBuf> {
     let files: Vec<&str> = doc
         .get("geometry")
         .and_then(Value::as_array)
-        .map(|g| g.iter().filter_map(|e| e.get("file").and_then(Value::as_str)).collect())
+        .map(|g| {
+            g.iter()
+                .filter_map(|e| e.get("file").and_then(Value::as_str))
+                .collect()
+        })
         .unwrap_or_default();
     if files.is_empty() {
         return None;
@@ -216,6 +258,53 @@ struct Counts {
     tables: usize,
 }
 
+/// Validates `value` against the scene file's schema, or against its definition `def`.
+fn validate(value: &Value, def: Option<&str>) -> Result<(), String> {
+    let mut schema = scene_schema();
+    if let Some(def) = def {
+        let defs = schema["$defs"].clone();
+        schema = serde_json::json!({ "$ref": format!("#/$defs/{def}"), "$defs": defs });
+    }
+    let validator = jsonschema::draft202012::new(&schema).unwrap();
+    let json = serde_json::to_value(value).unwrap();
+    let errors: Vec<String> = validator
+        .iter_errors(&json)
+        .map(|e| format!("{}: {e}", e.instance_path()))
+        .collect();
+    match errors.is_empty() {
+        true => Ok(()),
+        false => Err(format!(
+            "the schema{} refuses it: {}",
+            def.map(|d| format!("'s {d}")).unwrap_or_default(),
+            errors.join("; ")
+        )),
+    }
+}
+
+/// Validates each table of a (completed) fragment against the schema of its kind.
+fn validate_tables(doc: &Table) -> Result<(), String> {
+    for (key, value) in doc {
+        let each = |def: &str| -> Result<(), String> {
+            match value {
+                Value::Array(items) => items.iter().try_for_each(|i| validate(i, Some(def))),
+                Value::Table(t) => t.values().try_for_each(|i| validate(i, Some(def))),
+                _ => Err(format!("{key}: not a table")),
+            }
+        };
+        match key.as_str() {
+            "geometry" => each("GeometrySpec")?,
+            "procedural" => each("ProceduralSpec")?,
+            "media" => each("MediumSpec")?,
+            "surfaces" => each("SurfaceEntry")?,
+            "sources" => each("SourceSpec")?,
+            "detector" => validate(value, Some("DetectorSpec"))?,
+            "trace" => validate(value, Some("TraceSpec"))?,
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Checks one snippet; says how it was checked.
 fn check(s: &Snippet, counts: &mut Counts) -> Result<(), String> {
     let doc: Table = toml::from_str(&s.text).map_err(|e| format!("not TOML: {e}"))?;
@@ -223,9 +312,11 @@ fn check(s: &Snippet, counts: &mut Counts) -> Result<(), String> {
     if is_whole(&doc) && !s.tables_only {
         let folder = folder_for(&doc);
         counts.whole += 1;
+        validate(&Value::Table(doc.clone()), None)?;
         return load(&doc, folder.as_deref());
     }
     let done = read_tables(&doc, elided)?;
+    validate_tables(&done)?;
     match spliced(&done) {
         Some(scene) => {
             counts.spliced += 1;
@@ -257,14 +348,25 @@ fn every_toml_snippet_is_a_scene_or_a_fragment_the_loader_reads() {
         }
     }
     println!("toml snippets: {counts:?}");
-    assert!(failures.is_empty(), "snippets the loader refuses:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "snippets the loader refuses:\n{}",
+        failures.join("\n")
+    );
     // The README's scene is loaded whole; the reference's tables are spliced or read.
-    assert!(counts.whole >= 1 && counts.spliced >= 3 && counts.tables >= 5, "{counts:?}");
+    assert!(
+        counts.whole >= 1 && counts.spliced >= 3 && counts.tables >= 5,
+        "{counts:?}"
+    );
 }
 
 fn one(text: &str, tables_only: bool) -> (Result<(), String>, Counts) {
     let mut counts = Counts::default();
-    let s = Snippet { at: "t".into(), text: text.into(), tables_only };
+    let s = Snippet {
+        at: "t".into(),
+        text: text.into(),
+        tables_only,
+    };
     (check(&s, &mut counts), counts)
 }
 
@@ -272,11 +374,17 @@ fn one(text: &str, tables_only: bool) -> (Result<(), String>, Counts) {
 fn a_snippet_the_loader_would_refuse_is_refused() {
     // An unknown key in a fragment, a wrong type, a value the checks refuse once spliced,
     // and a whole scene that does not load.
-    let (r, _) = one("[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\ncolour = 1\n", false);
+    let (r, _) = one(
+        "[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 0.9\ncolour = 1\n",
+        false,
+    );
     assert!(r.unwrap_err().contains("colour"));
     let (r, _) = one("[detector]\n# ...\nbins = \"many\"\n", false);
     assert!(r.unwrap_err().contains("detector"));
-    let (r, c) = one("[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 1.5\n", false);
+    let (r, c) = one(
+        "[surfaces.sheet]\nmodel = \"lambert\"\nalbedo = 1.5\n",
+        false,
+    );
     assert_eq!(c.spliced, 1);
     assert!(r.unwrap_err().contains("surfaces.reflector_sheet.albedo"));
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
@@ -287,6 +395,9 @@ fn a_snippet_the_loader_would_refuse_is_refused() {
     assert!(r.unwrap_err().contains("sources[0].radius_mm"));
     let (r, c) = one(&scene, false);
     assert_eq!((r, c.whole), (Ok(()), 1));
+    // A key the schema does not know, in a fragment read table by table.
+    let (r, _) = one("[[geometry]]\nfile = \"a.obj\"\nunit = \"mm\"\n", false);
+    assert!(r.unwrap_err().contains("unit"));
     // Marked: read table by table.
     let (r, c) = one(&scene, true);
     assert_eq!((r, c.whole), (Ok(()), 0));

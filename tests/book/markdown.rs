@@ -52,9 +52,16 @@ pub fn split(text: &str) -> (Vec<Block>, String) {
         match &mut open {
             None if trimmed.starts_with("```") => {
                 let indent = line.len() - trimmed.len();
-                let fence = trimmed.chars().take_while(|&c| c == '`').collect::<String>();
+                let fence = trimmed
+                    .chars()
+                    .take_while(|&c| c == '`')
+                    .collect::<String>();
                 let info = trimmed[fence.len()..].trim().to_owned();
-                let block = Block { info, text: String::new(), line: i + 1 };
+                let block = Block {
+                    info,
+                    text: String::new(),
+                    line: i + 1,
+                };
                 open = Some((format!("{}{fence}", " ".repeat(indent)), block));
                 prose.push('\n');
             }
@@ -63,7 +70,9 @@ pub fn split(text: &str) -> (Vec<Block>, String) {
                 prose.push('\n');
             }
             Some((fence, block)) => {
-                if trimmed.starts_with(fence.trim_start()) && trimmed.trim_end().chars().all(|c| c == '`') {
+                if trimmed.starts_with(fence.trim_start())
+                    && trimmed.trim_end().chars().all(|c| c == '`')
+                {
                     blocks.push(open.take().unwrap().1);
                 } else {
                     let indent = fence.len() - fence.trim_start().len();
@@ -114,13 +123,22 @@ pub fn anchors(prose: &str) -> Vec<String> {
             .trim()
             .chars()
             .filter_map(|c| match c {
-                c if c.is_alphanumeric() || c == '_' || c == '-' => Some(c.to_lowercase().next().unwrap()),
+                c if c.is_alphanumeric() || c == '_' || c == '-' => {
+                    Some(c.to_lowercase().next().unwrap())
+                }
                 c if c.is_whitespace() => Some('-'),
                 _ => None,
             })
             .collect();
-        let repeats = out.iter().filter(|a| *a == &id || a.starts_with(&format!("{id}-"))).count();
-        out.push(if repeats == 0 { id } else { format!("{id}-{repeats}") });
+        let repeats = out
+            .iter()
+            .filter(|a| *a == &id || a.starts_with(&format!("{id}-")))
+            .count();
+        out.push(if repeats == 0 {
+            id
+        } else {
+            format!("{id}-{repeats}")
+        });
     }
     out
 }
@@ -133,7 +151,9 @@ pub fn links(prose: &str) -> Vec<(usize, String)> {
     let mut offset = 0;
     while let Some(at) = rest.find("](") {
         let start = at + 2;
-        let Some(len) = rest[start..].find(')') else { break };
+        let Some(len) = rest[start..].find(')') else {
+            break;
+        };
         let target = rest[start..start + len].trim().to_owned();
         let line = text[..offset + at].matches('\n').count() + 1;
         out.push((line, target));

@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
 /// `[[sources]]` with `type = "ccfl"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CcflSpec {
     /// Name for reports.

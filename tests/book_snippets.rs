@@ -116,10 +116,18 @@ fn read_tables(doc: &Table, elided: bool) -> Result<Table, String> {
     for (key, value) in doc {
         match key.as_str() {
             "version" | "name" | "description" => {}
-            "geometry" => drop(typed::<Vec<GeometrySpec>>(value, key)?),
-            "procedural" => drop(typed::<Vec<ProceduralSpec>>(value, key)?),
-            "media" => drop(typed::<BTreeMap<String, MediumSpec>>(value, key)?),
-            "surfaces" => drop(typed::<BTreeMap<String, SurfaceEntry>>(value, key)?),
+            "geometry" => {
+                typed::<Vec<GeometrySpec>>(value, key)?;
+            }
+            "procedural" => {
+                typed::<Vec<ProceduralSpec>>(value, key)?;
+            }
+            "media" => {
+                typed::<BTreeMap<String, MediumSpec>>(value, key)?;
+            }
+            "surfaces" => {
+                typed::<BTreeMap<String, SurfaceEntry>>(value, key)?;
+            }
             "sources" => {
                 let mut sources = Vec::new();
                 for (i, s) in value
@@ -148,7 +156,9 @@ fn read_tables(doc: &Table, elided: bool) -> Result<Table, String> {
                 typed::<DetectorSpec>(&Value::Table(d.clone()), key)?;
                 done.insert(key.clone(), Value::Table(d));
             }
-            "trace" => drop(typed::<TraceSpec>(value, key)?),
+            "trace" => {
+                typed::<TraceSpec>(value, key)?;
+            }
             other => return Err(format!("{other}: not a key of a scene file")),
         }
     }

@@ -41,7 +41,7 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 #[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DetectorSpec {
-    /// A corner of the rectangle.
+    /// A corner of the rectangle (mm).
     pub origin: [f64; 3],
     /// Grid-x axis.
     pub u: [f64; 3],

@@ -78,7 +78,7 @@ pub struct DotsSpec {
     pub lattice: Lattice,
     /// Cell pitch (mm).
     pub pitch_mm: f64,
-    /// A point on the lamp edge, in the face.
+    /// A point on the lamp edge, in the face (mm).
     pub origin: [f64; 3],
     /// Propagation direction.
     pub axis: [f64; 3],

@@ -55,11 +55,11 @@ pub enum ProceduralSpec {
     DirectLitBox {
         /// Tag of every face.
         tag: String,
-        /// Inner corner at the valleys' level.
+        /// Inner corner at the valleys' level (mm).
         origin: [f64; 3],
-        /// Inner size: x (across the lamps), y (along them), depth.
+        /// Inner size (mm): x (across the lamps), y (along them), depth.
         size_mm: [f64; 3],
-        /// Ridge height above the valleys (0: flat).
+        /// Ridge height above the valleys (mm; 0: flat).
         #[serde(default)]
         ridge_height_mm: f64,
         /// Profile of the troughs.
@@ -73,7 +73,7 @@ pub enum ProceduralSpec {
     LampHolder {
         /// Tag of every face.
         tag: String,
-        /// Centre of the lamp axis.
+        /// Centre of the lamp axis (mm).
         center: [f64; 3],
         /// Lamp axis.
         axis: [f64; 3],

@@ -31,7 +31,7 @@ use std::f64::consts::TAU;
 pub struct CcflSpec {
     /// Name for reports.
     pub name: Option<String>,
-    /// Centre of the tube.
+    /// Centre of the tube (mm).
     pub center: [f64; 3],
     /// Tube axis.
     pub axis: [f64; 3],

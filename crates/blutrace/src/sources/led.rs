@@ -37,7 +37,7 @@ use std::sync::Arc;
 pub struct LedSpec {
     /// Name for reports.
     pub name: Option<String>,
-    /// Centre of the emitting rectangle.
+    /// Centre of the emitting rectangle (mm).
     pub center: [f64; 3],
     /// Emitting normal.
     pub normal: [f64; 3],

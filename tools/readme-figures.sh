@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Re-measure the README's figures: the gallery images in docs/img/, the optimizer tables
+# Re-measure the book's figures: the gallery images in docs/book/src/img/, the optimizer tables
 # and the bench table. Results are deterministic (fixed seeds); only the timings depend on
 # the machine and its load, so run it on a quiet machine.
 #
 #   bash tools/readme-figures.sh [gallery|optimize|layout|volume|bench|bodies|placement|all]   (default: all)
 #
-# Logs go to out/figures/*.log; the README tables are filled in from them by hand.
+# Logs go to out/figures/*.log; the book's tables are filled in from them by hand.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q
@@ -26,9 +26,9 @@ gallery() {
   for s in notebook14 wedge-ccfl phone-led direct-lit cad-reflector bef-stack diffusion-lgp; do
     "$bin" trace "scenes/$s" --photons 1000000 --estimator weighted --quiet \
       --out "$out/$s" >"$out/$s.log"
-    cp "$out/$s/flux.png" "docs/img/$s-flux.png"
+    cp "$out/$s/flux.png" "docs/book/src/img/$s-flux.png"
   done
-  cp "$out/notebook14/convergence.png" docs/img/notebook14-convergence.png
+  cp "$out/notebook14/convergence.png" docs/book/src/img/notebook14-convergence.png
 }
 
 optimize() {
@@ -42,11 +42,11 @@ optimize() {
     --cells 28,14 --out "$out/phone-2d-28"
   timed "$out/phone-2d.log" "$bin" optimize scenes/phone-led --method feedback --dims 2 \
     --out "$out/phone-2d"
-  cp "$out/phone-2d/initial/flux.png" docs/img/phone-led-2d-initial.png
-  cp "$out/phone-2d/final/flux.png" docs/img/phone-led-2d-final.png
+  cp "$out/phone-2d/initial/flux.png" docs/book/src/img/phone-led-2d-initial.png
+  cp "$out/phone-2d/final/flux.png" docs/book/src/img/phone-led-2d-final.png
 }
 
-# notebook14's efficiency for each lamp body (README "Lamp bodies"): the scene copied with
+# notebook14's efficiency for each lamp body (book, scene/sources.md "Lamp bodies"): the scene copied with
 # every source's body replaced.
 bodies() {
   local dir=$out/bodies
@@ -79,12 +79,12 @@ placement() {
 }
 
 volume() {
-  # The diffusion-lgp profile table (README, "Diffusion light guides").
+  # The diffusion-lgp profile table (book, scene/media.md, "Diffusion light guides").
   cargo test --release -q --test variants -- --ignored diffusion_lgp_profile_table \
     --nocapture >"$out/diffusion-lgp-profile.log" 2>&1
 }
 
-# README "Optimizing the layout and the reflectors": direct-lit-rows (6 lamps) over lamp
+# The book's "Optimizing the layout and the reflectors": direct-lit-rows (6 lamps) over lamp
 # height, pitch and ridge height; then the lamp count 4..8 with the pitch searched for each.
 layout() {
   # The bulk-diffuser plate makes direct-lit slow to trace (about 50k photons/s on 2
@@ -104,7 +104,7 @@ layout() {
     --method feedback --photons 200000 --verify-photons 2000000 --out "$out/layout-holder-dots"
 }
 
-# Every table of the README's "Backends" section: first blutrace against the reference
+# Every table of the book's "Backends" section (performance.md): first blutrace against the reference
 # kernel on scenes/bench-box (speed of light), then the backends on notebook14.
 bench() {
   # 1e6 photons, 5 rounds: at 2e5 the kernel's rounds last 50 ms and its rate varied 1.4x.

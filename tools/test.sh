@@ -3,7 +3,9 @@
 # Fetches the Embree 4 library first, so every backend is tested; on a machine without
 # network, set BLUTRACE_SKIP_EMBREE=1 to test the pure-Rust backends only. After the Rust
 # tests, tools/test-python.sh builds the Python package and runs its pytest suite (a venv
-# under target/, packages from PyPI); BLUTRACE_SKIP_PYTHON=1 skips it.
+# under target/, packages from PyPI); BLUTRACE_SKIP_PYTHON=1 skips it. Before them,
+# tools/book.sh builds the book and the library's API docs (mdBook from crates.io into
+# target/tools the first time).
 #
 # The tests run with TMPDIR set to a new empty folder, so nothing an earlier run left in
 # the machine's temporary folder can make a test pass; afterwards that folder must be
@@ -24,6 +26,8 @@ checkout_files() {
     ':(exclude)fuzz/corpus' ':(exclude)fuzz/artifacts' ':(exclude)fuzz/coverage' 2>/dev/null | sort
 }
 before=$(checkout_files)
+
+bash tools/book.sh
 
 TMPDIR="$scratch" cargo test --workspace --release "$@"
 if [ "${BLUTRACE_SKIP_PYTHON:-0}" != "1" ]; then

@@ -1,5 +1,5 @@
 //! The `blutrace` command line: one subcommand per file (`trace` and `merge`, `check`,
-//! `bench`, `optimize`), each a thin layer that parses options, calls the library and
+//! `bench`, `optimize`; `schema` prints the library's scene-file schema), each a thin layer that parses options, calls the library and
 //! prints. `src/main.rs` only calls [`main`].
 
 /// `println!` for the command line's reports, which never stops the work: a reader that
@@ -51,7 +51,7 @@ enum Command {
     /// Optimize the ink-dot density for uniformity (Nelder-Mead or feedback), or any
     /// numbers of the scene file (`--vary`).
     Optimize(Box<optimize::OptimizeArgs>),
-    /// Measure photons/s per backend (ratios in one run; see the README's table).
+    /// Measure photons/s per backend (ratios in one run; see the book's Performance and backends page).
     Bench {
         /// Photons per configuration.
         #[arg(long, default_value_t = 200_000, value_parser = blutrace::count::parse_photons)]
@@ -81,6 +81,9 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Print the JSON Schema (draft 2020-12) of the scene file, for editors and validators
+    /// (`.taplo.toml` associates scene files with it).
+    Schema,
 }
 
 /// Parse the command line, run it, and report an error on stderr.
@@ -186,6 +189,11 @@ impl Command {
             }
             Command::Check { scene, json } => check::check(&scene_path(&scene), json),
             Command::Bsdf(args) => bsdf::bsdf(args),
+            Command::Schema => {
+                let schema = blutrace::scene::schema::scene_schema();
+                say!("{}", serde_json::to_string_pretty(&schema)?);
+                Ok(())
+            }
         };
         done.map(|()| ExitCode::SUCCESS)
     }

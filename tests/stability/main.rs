@@ -2,7 +2,7 @@
 //! One file per family of cases (`fresnel_cases`, `thin_plate`, `scale`, `enclosures`,
 //! `meshes`, `dots`, `tallies`); this one holds the rows, the doc and shared helpers.
 //!
-//! Every case is a function returning one row of `docs/stability.md`: what could go wrong,
+//! Every case is a function returning one row of `docs/book/src/stability-cases.md`: what could go wrong,
 //! what blutrace does, the expected answer and the measured one. Each case is also a test
 //! (the slow ones `#[ignore]`d), and each test checks that the doc's row for it carries the
 //! verdict and the measured numbers the case gets now (the numbers where Embree is
@@ -137,7 +137,7 @@ const CASES: &[Case] = &[
     ("exact-sum-1e9", true, exact_sum_1e9),
 ];
 
-const DOC: &str = "docs/stability.md";
+const DOC: &str = "docs/book/src/stability-cases.md";
 const REGENERATE: &str =
     "cargo test --release --test stability -- --ignored regenerate_stability_doc";
 
@@ -300,9 +300,9 @@ slow_case_tests! {
     case_exact_sum_1e9 = "exact-sum-1e9",
 }
 
-/// Runs every case and rewrites `docs/stability.md`.
+/// Runs every case and rewrites `docs/book/src/stability-cases.md`.
 #[test]
-#[ignore = "rewrites docs/stability.md: cargo test --release --test stability -- --ignored regenerate_stability_doc"]
+#[ignore = "rewrites docs/book/src/stability-cases.md: cargo test --release --test stability -- --ignored regenerate_stability_doc"]
 fn regenerate_stability_doc() {
     let mut rows = Vec::new();
     for (id, slow, f) in CASES {

@@ -49,10 +49,10 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// `[detector]`: the target plane as the scene file gives it.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DetectorSpec {
-    /// A corner of the rectangle.
+    /// A corner of the rectangle (mm).
     pub origin: [f64; 3],
     /// Grid-x axis.
     pub u: [f64; 3],

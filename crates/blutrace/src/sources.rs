@@ -85,6 +85,41 @@ impl<'de> Deserialize<'de> for SourceSpec {
     }
 }
 
+impl schemars::JsonSchema for SourceSpec {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "SourceSpec".into()
+    }
+
+    /// One closed table per `type`, as `deserialize` reads them.
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        use crate::scene::schema::{one_of, tagged};
+        let choices = vec![
+            tagged::<CcflSpec>(
+                generator,
+                "type",
+                "ccfl",
+                "Cold-cathode fluorescent lamp: a Lambertian cylinder.",
+                &[],
+            ),
+            tagged::<LedSpec>(
+                generator,
+                "type",
+                "led",
+                "Flat LED emitter with a cos^m profile or a measured intensity table.",
+                &[],
+            ),
+            tagged::<RayFileSpec>(
+                generator,
+                "type",
+                "rayfile",
+                "Rays from a TM-25 or text ray file.",
+                &[],
+            ),
+        ];
+        one_of("[[sources]]: a light source; `type` picks it.", choices)
+    }
+}
+
 /// What every source entry gives besides its emitting shape.
 struct Common<'a> {
     name: &'a Option<String>,

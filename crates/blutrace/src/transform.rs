@@ -8,7 +8,7 @@ use glam::{DMat3, DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
 /// Length units of a geometry file or ray file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Units {
     /// Millimetres.

@@ -96,7 +96,17 @@ pub fn check_cells(ctx: &Ctx, field: &str, span: f64, pitch: f64) -> Result<()> 
 }
 
 /// How the polynomial's variable is measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    serde::Deserialize,
+    serde::Serialize,
+    Default,
+    schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum XUnit {
     /// Distance divided by the span from the lamp edge to the far edge (or to the centre
@@ -128,7 +138,7 @@ pub enum Density {
 /// `x` (`0..=x_max`), across it in mm (`v_min..=v_min + width`). In a scene file,
 /// `density_grid = { width_mm = W, v_min_mm = V, values = [[...], ...] }`: rows across
 /// the axis, columns along it; `x_max` follows from the pattern (see [`graded_x_max`]).
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DensityGrid {
     /// The polynomial variable at the last column of knots (set when the pattern is

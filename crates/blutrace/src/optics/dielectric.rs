@@ -18,7 +18,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// `[surfaces.TAG]` with `model = "dielectric"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DielectricSpec {
     /// Medium behind the face.

@@ -46,7 +46,7 @@ use std::f64::consts::TAU;
 pub const MAX_ROUGHNESS: f64 = 4.0;
 
 /// `[surfaces.TAG]` with `model = "diffuser"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DiffuserSpec {
     /// Medium behind the face.

@@ -64,7 +64,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// `[surfaces.TAG]` with `model = "dots"`: a dielectric face printed with ink dots.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DotsSpec {
     /// Medium behind the face.
@@ -78,7 +78,7 @@ pub struct DotsSpec {
     pub lattice: Lattice,
     /// Cell pitch (mm).
     pub pitch_mm: f64,
-    /// A point on the lamp edge, in the face.
+    /// A point on the lamp edge, in the face (mm).
     pub origin: [f64; 3],
     /// Propagation direction.
     pub axis: [f64; 3],
@@ -235,7 +235,9 @@ impl SurfaceSpecOf for DotsSpec {
 }
 
 /// Cell lattice of the dot grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Lattice {
     /// Square cells of side `pitch`.

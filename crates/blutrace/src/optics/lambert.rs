@@ -19,7 +19,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// `[surfaces.TAG]` with `model = "lambert"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LambertSpec {
     /// Albedo: a number or a table over wavelength ([`super::spectrum`]).

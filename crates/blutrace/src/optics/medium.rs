@@ -165,7 +165,7 @@ pub struct Interface {
 }
 
 /// `[media.NAME]`: a homogeneous medium in the scene file.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MediumSpec {
     /// Refractive index: a number, a table or a dispersion formula ([`super::spectrum`]).

@@ -40,6 +40,21 @@ impl Serialize for OpaqueSpec {
     }
 }
 
+impl schemars::JsonSchema for OpaqueSpec {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "OpaqueSpec".into()
+    }
+
+    /// What `OpaqueVisitor` reads: `"absorber"` or a model's table.
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let model = generator.subschema_for::<SurfaceSpec>();
+        crate::scene::schema::one_of(
+            "An opaque surface model: \"absorber\" (every photon that meets it ends there) or a table of a model that keeps light on its side (lambert, phong, mirror, absorber), with its [surfaces.*] keys.",
+            vec![schemars::json_schema!({ "const": "absorber" }), model],
+        )
+    }
+}
+
 impl<'de> Deserialize<'de> for OpaqueSpec {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         d.deserialize_any(OpaqueVisitor)

@@ -22,7 +22,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// `[surfaces.TAG]` with `model = "phong"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PhongSpec {
     /// Total reflectance.

@@ -41,7 +41,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// `[surfaces.TAG]` with `model = "polarizer"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PolarizerSpec {
     /// The pass axis, projected into the face.

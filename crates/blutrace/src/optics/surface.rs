@@ -46,11 +46,11 @@ pub use crate::estimator::Estimator;
 
 /// Generates [`SurfaceModel`], [`SurfaceSpec`] and their dispatch from the registry.
 macro_rules! surface_models {
-    ($( $(#[$doc:meta])* $name:literal => $Variant:ident($Model:ty, $Spec:ty), )*) => {
+    ($( $(#[doc = $doc:literal])* $name:literal => $Variant:ident($Model:ty, $Spec:ty), )*) => {
         /// The optical model of one tag: one variant per registered model.
         #[derive(Clone, Debug, PartialEq)]
         pub enum SurfaceModel {
-            $( $(#[$doc])* $Variant($Model), )*
+            $( $(#[doc = $doc])* $Variant($Model), )*
         }
 
         /// A `[surfaces.TAG]` table: `model = "..."` picks the model, whose spec owns the
@@ -58,7 +58,7 @@ macro_rules! surface_models {
         #[derive(Clone, Debug, Deserialize, Serialize)]
         #[serde(tag = "model")]
         pub enum SurfaceSpec {
-            $( $(#[$doc])* #[serde(rename = $name)] $Variant($Spec), )*
+            $( $(#[doc = $doc])* #[serde(rename = $name)] $Variant($Spec), )*
         }
 
         impl SurfaceModel {
@@ -143,6 +143,32 @@ macro_rules! surface_models {
                 match self {
                     $( SurfaceSpec::$Variant(s) => s.files(), )*
                 }
+            }
+
+            /// One closed table per registered model, `model = "..."` required in each,
+            /// with the `extra` keys every such table may carry (a surface's `back`).
+            pub fn model_schemas(
+                generator: &mut schemars::SchemaGenerator,
+                extra: &[(&str, schemars::Schema)],
+            ) -> Vec<schemars::Schema> {
+                vec![$(
+                    crate::scene::schema::tagged::<$Spec>(
+                        generator, "model", $name, concat!($($doc),*).trim(), extra,
+                    ),
+                )*]
+            }
+        }
+
+        impl schemars::JsonSchema for SurfaceSpec {
+            fn schema_name() -> std::borrow::Cow<'static, str> {
+                "SurfaceSpec".into()
+            }
+
+            fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+                crate::scene::schema::one_of(
+                    "A surface model's table: `model` picks the model, whose keys follow.",
+                    SurfaceSpec::model_schemas(generator, &[]),
+                )
             }
         }
     };

@@ -54,6 +54,28 @@ impl<'de> Deserialize<'de> for SurfaceEntry {
     }
 }
 
+impl schemars::JsonSchema for SurfaceEntry {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "SurfaceEntry".into()
+    }
+
+    /// One closed table per model, each also taking `back` (as `deserialize` reads it).
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let mut back = generator.subschema_for::<OpaqueSpec>();
+        back.insert(
+            "description".into(),
+            "The model of the back, which a photon arriving along the triangle's normal \
+             (from behind) meets: \"absorber\" or an opaque model's table. Without it both \
+             sides carry the front's model."
+                .into(),
+        );
+        crate::scene::schema::one_of(
+            "[surfaces.TAG]: the optical model of the faces tagged TAG. `model` picks the model, whose keys follow; an opaque model may give its back another (`back`).",
+            SurfaceSpec::model_schemas(generator, &[("back", back)]),
+        )
+    }
+}
+
 impl SurfaceEntry {
     /// Check `[surfaces.TAG]` (at `at`) and build its model and its back's, if any.
     pub fn build(

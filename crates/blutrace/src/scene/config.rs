@@ -55,7 +55,7 @@ use std::collections::BTreeMap;
 pub const SCENE_VERSION: u32 = 1;
 
 /// A whole scene file.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// Format version; must be [`SCENE_VERSION`].
@@ -85,7 +85,7 @@ pub struct SceneFile {
 }
 
 /// Tracing defaults.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TraceSpec {
     /// Default photon count.

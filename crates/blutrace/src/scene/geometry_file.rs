@@ -35,7 +35,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// One geometry file and its placement.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GeometrySpec {
     /// Path to an `.obj`, `.gltf`, `.glb`, `.stl` or `.ply` file.
@@ -68,7 +68,7 @@ fn one() -> f64 {
 }
 
 /// Which axis of a file points to blutrace's +z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum UpAxis {
     /// The file's +z (no turn).

@@ -21,6 +21,7 @@ mod lamp_placement;
 mod media_checks;
 pub mod meshio;
 pub mod procedural;
+pub mod schema;
 mod solids;
 
 use crate::accel::convex::ConvexSolid;

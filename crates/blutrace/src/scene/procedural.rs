@@ -48,18 +48,18 @@ use serde::{Deserialize, Serialize};
 pub const MAX_SEGMENTS: usize = 4096;
 
 /// `[[procedural]]`: one generated part.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ProceduralSpec {
     /// A direct-lit box: ridged or flat back reflector and four walls, open at the top.
     DirectLitBox {
         /// Tag of every face.
         tag: String,
-        /// Inner corner at the valleys' level.
+        /// Inner corner at the valleys' level (mm).
         origin: [f64; 3],
-        /// Inner size: x (across the lamps), y (along them), depth.
+        /// Inner size (mm): x (across the lamps), y (along them), depth.
         size_mm: [f64; 3],
-        /// Ridge height above the valleys (0: flat).
+        /// Ridge height above the valleys (mm; 0: flat).
         #[serde(default)]
         ridge_height_mm: f64,
         /// Profile of the troughs.
@@ -73,7 +73,7 @@ pub enum ProceduralSpec {
     LampHolder {
         /// Tag of every face.
         tag: String,
-        /// Centre of the lamp axis.
+        /// Centre of the lamp axis (mm).
         center: [f64; 3],
         /// Lamp axis.
         axis: [f64; 3],
@@ -107,7 +107,9 @@ fn yes() -> bool {
 }
 
 /// The troughs' profile.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
     /// Straight slopes from the valley to the ridges.
@@ -118,7 +120,7 @@ pub enum Profile {
 }
 
 /// A lamp holder's section, in the plane across the lamp axis.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Section {
     /// A circle centred on the lamp axis.

@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 pub const MAX_COUNT: usize = 100_000;
 
 /// `array = { ... }` of a `[[sources]]` entry.
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ArraySpec {
     /// Number of sources in the row (at least 1).

@@ -65,6 +65,21 @@ impl Serialize for BodySpec {
     }
 }
 
+impl schemars::JsonSchema for BodySpec {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "BodySpec".into()
+    }
+
+    /// What `BodyVisitor` reads: `"transparent"`, or what [`OpaqueSpec`] reads.
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let opaque = generator.subschema_for::<OpaqueSpec>();
+        crate::scene::schema::one_of(
+            "What light returning to the lamp meets: \"absorber\" (the default), \"transparent\" (no body, for scenes that mesh the lamp themselves) or an opaque model's table.",
+            vec![schemars::json_schema!({ "const": "transparent" }), opaque],
+        )
+    }
+}
+
 impl<'de> Deserialize<'de> for BodySpec {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         d.deserialize_any(BodyVisitor)

@@ -26,12 +26,12 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
 /// `[[sources]]` with `type = "ccfl"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CcflSpec {
     /// Name for reports.
     pub name: Option<String>,
-    /// Centre of the tube.
+    /// Centre of the tube (mm).
     pub center: [f64; 3],
     /// Tube axis.
     pub axis: [f64; 3],

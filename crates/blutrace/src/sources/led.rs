@@ -32,12 +32,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// `[[sources]]` with `type = "led"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LedSpec {
     /// Name for reports.
     pub name: Option<String>,
-    /// Centre of the emitting rectangle.
+    /// Centre of the emitting rectangle (mm).
     pub center: [f64; 3],
     /// Emitting normal.
     pub normal: [f64; 3],

@@ -61,6 +61,39 @@ impl TryFrom<Keys> for SourcePolarizationSpec {
     }
 }
 
+impl schemars::JsonSchema for SourcePolarizationSpec {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "SourcePolarizationSpec".into()
+    }
+
+    /// One of the two closed tables `Keys` and its `try_from` accept.
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        schemars::json_schema!({
+            "description": "The state of the emitted light, relative to the source's u axis made perpendicular to each photon's direction; unpolarized without it.",
+            "oneOf": [
+                {
+                    "type": "object",
+                    "properties": { "linear_deg": {
+                        "type": "number",
+                        "description": "Fully linearly polarized at this angle (degrees) from u towards v = direction x u."
+                    } },
+                    "required": ["linear_deg"],
+                    "additionalProperties": false
+                },
+                {
+                    "type": "object",
+                    "properties": { "stokes": {
+                        "type": "array", "items": { "type": "number" }, "minItems": 4, "maxItems": 4,
+                        "description": "A Stokes vector [S0, S1, S2, S3] (scaled to S0 = 1)."
+                    } },
+                    "required": ["stokes"],
+                    "additionalProperties": false
+                }
+            ]
+        })
+    }
+}
+
 impl SourcePolarizationSpec {
     /// Check the entry at `field` and give its state, of unit power.
     pub fn build(&self, ctx: &Ctx, field: &str) -> Result<Stokes> {

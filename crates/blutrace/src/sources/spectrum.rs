@@ -39,8 +39,10 @@ pub const VISIBLE_NM: (f64, f64) = (360.0, 830.0);
 pub const MIX_STEP_NM: f64 = 1e-6;
 
 /// `spectrum = ...` of a `[[sources]]` entry.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+// The schema is the one-key tables `deserialize` below reads.
+#[derive(Clone, Debug, PartialEq, Serialize, schemars::JsonSchema)]
 #[serde(untagged)]
+#[schemars(deny_unknown_fields)]
 pub enum SpectrumSpec {
     /// A named spectrum.
     Named(String),

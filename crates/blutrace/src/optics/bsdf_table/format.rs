@@ -65,7 +65,9 @@ impl ScatterType {
 pub const MAX_BSDF: f64 = 1e12;
 
 /// A tristimulus channel of an XYZ table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, schemars::JsonSchema,
+)]
 pub enum Channel {
     /// The x̄-weighted table.
     X,

@@ -74,7 +74,7 @@ use std::sync::Arc;
 pub const MAX_U_AXIS_COS: f64 = 0.999;
 
 /// One file or several.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(untagged)]
 pub enum Files {
     /// One file.
@@ -93,7 +93,7 @@ impl Files {
 }
 
 /// `[surfaces.TAG]` with `model = "bsdf_table"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BsdfTableSpec {
     /// The IS BSDF file(s), relative to the scene file: light arriving on the front.

@@ -16,7 +16,9 @@ pub const MAX_CELLS: usize = 1 << 16;
 pub const MAX_EVENTS: usize = 1000;
 
 /// Which way the V profile stands off the mean plane.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Relief {
     /// V notches cut into the `inside` medium (filled with the `outside` one).

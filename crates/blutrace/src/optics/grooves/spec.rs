@@ -19,7 +19,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// `[surfaces.TAG]` with `model = "grooves"`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GroovesSpec {
     /// Medium behind the face.
@@ -38,7 +38,7 @@ pub struct GroovesSpec {
     pub tilt_deg: f64,
     /// Groove pitch (mm).
     pub pitch_mm: f64,
-    /// A point on the lamp edge (where the first cell starts).
+    /// A point on the lamp edge (mm), where the first cell starts.
     pub origin: [f64; 3],
     /// In-face direction across the grooves (away from the lamp).
     pub axis: [f64; 3],

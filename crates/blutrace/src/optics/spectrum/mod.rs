@@ -216,8 +216,11 @@ impl From<f64> for Spectral {
 }
 
 /// A wavelength-dependent quantity as a scene file gives it (see the module header).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+// The schema is the one-key tables `deserialize` below reads (a table with another key, or
+// with two, is refused there too).
+#[derive(Clone, Debug, PartialEq, Serialize, schemars::JsonSchema)]
 #[serde(untagged)]
+#[schemars(deny_unknown_fields)]
 pub enum SpectralValue {
     /// The same at every wavelength.
     Constant(f64),
@@ -239,7 +242,7 @@ pub enum SpectralValue {
 }
 
 /// n² = 1 + Σ bᵢ λ²/(λ² − cᵢ), λ in µm.
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Sellmeier {
     /// The oscillator strengths bᵢ.

@@ -1,4 +1,4 @@
-"""The README's Python example runs as printed (scene paths made absolute, run elsewhere)."""
+"""The book's Python example runs as printed (scene paths made absolute, run elsewhere)."""
 
 from __future__ import annotations
 
@@ -12,16 +12,20 @@ import pytest
 from conftest import REPO
 
 
-def test_the_readmes_python_example_runs(tmp_path):
+def test_the_books_python_example_runs(tmp_path):
     # The design study needs the extras (pinned in requirements-test.txt for Python 3.11+).
     study = all(importlib.util.find_spec(m) for m in ["pandas", "xarray", "matplotlib"])
-    readme = (REPO / "README.md").read_text()
-    section = readme.split("## From Python", 1)[1]
-    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    page = (REPO / "docs/book/src/python.md").read_text()
+    section = page.split("# From Python", 1)[1]
+    blocks = re.findall(r"```python
+(.*?)```", section, re.S)
     # The first block, then the design study that continues it (with its extras).
     code = blocks[0]
     if study:
-        code += "\nimport matplotlib\nmatplotlib.use('Agg')\n" + blocks[1]
+        code += "
+import matplotlib
+matplotlib.use('Agg')
+" + blocks[1]
     code = code.replace('"scenes/', f'"{REPO}/scenes/')
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert done.returncode == 0, done.stderr

@@ -96,7 +96,9 @@ fn a_lambertian_floor_reads_albedo_e_over_pi_from_every_view() {
         );
         assert!((v - expected).abs() < 3.0 * e, "{m:?}");
         assert!(e < 0.005 * expected, "{m:?}");
-        assert!(!(c.mean_cd_m2.stderr < 5.0 * e), "{m:?} {c:?}");
+        // The cone count's error is far larger, or undefined (no photon in the cone).
+        let cone_error = c.mean_cd_m2.stderr;
+        assert!(cone_error.is_nan() || cone_error >= 5.0 * e, "{m:?} {c:?}");
         assert!(m.cone_counted_fraction < 1e-12, "{m:?}");
         assert_eq!(c.cone_counted_fraction, 1.0, "{c:?}");
     }

@@ -5,7 +5,8 @@
 //!
 //! Each photon's contributions to one bin of one view are summed before they are scored
 //! ([`MeterHit`]s merged per photon), so a bin's sum of squares is over photons, as every
-//! tally's is ([`super::BinStats`]), and its errors stay right though one photon scores a bin many times.
+//! tally's is ([`super::BinStats`]), and its errors stay right though one photon scores a
+//! bin many times.
 
 use super::{ExactSum, Grid, Sign};
 use crate::optics::spectrum::{Light, Secondaries};
@@ -192,7 +193,7 @@ impl MeterTally {
 }
 
 /// Merge one photon's `hits` (the tail of a chunk's list it scored) to one per view and
-/// bin, in (view, bin) order: the sums are then per photon, as [`BinStats`] wants.
+/// bin, in (view, bin) order: the sums are then per photon, as [`super::BinStats`] wants.
 pub fn merge_photon_hits(hits: &mut Vec<MeterHit>, from: usize) {
     let mine = &mut hits[from..];
     if mine.len() < 2 {

@@ -134,7 +134,29 @@ def render() -> str:
             out += [f"## function `{node.name}`", "", "```python", signature(node, None), "```", ""]
             if doc(node):
                 out += [doc(node), ""]
+    out += submodules(module)
     return "\n".join(out).rstrip() + "\n"
+
+
+def submodules(module: ast.Module) -> list[str]:
+    """The sections of the package's public submodules (`from . import name`): their
+    docstring and functions."""
+    out = []
+    for node in module.body:
+        if not (isinstance(node, ast.ImportFrom) and node.module is None and node.level == 1):
+            continue
+        for alias in node.names:
+            if not is_public(alias.name):
+                continue
+            sub = ast.parse((PACKAGE / f"{alias.name}.py").read_text())
+            out += [f"## module `{alias.name}`", "", fence_doctests(doc(sub)), ""]
+            for fn in sub.body:
+                if isinstance(fn, ast.FunctionDef) and is_public(fn.name):
+                    qualified = f"{alias.name}.{fn.name}"
+                    out += [f"### `{qualified}`", "", "```python", signature(fn, None), "```", ""]
+                    if doc(fn):
+                        out += [doc(fn), ""]
+    return out
 
 
 def main() -> int:

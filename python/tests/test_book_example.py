@@ -17,15 +17,11 @@ def test_the_books_python_example_runs(tmp_path):
     study = all(importlib.util.find_spec(m) for m in ["pandas", "xarray", "matplotlib"])
     page = (REPO / "docs/book/src/python.md").read_text()
     section = page.split("# From Python", 1)[1]
-    blocks = re.findall(r"```python
-(.*?)```", section, re.S)
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
     # The first block, then the design study that continues it (with its extras).
     code = blocks[0]
     if study:
-        code += "
-import matplotlib
-matplotlib.use('Agg')
-" + blocks[1]
+        code += "\nimport matplotlib\nmatplotlib.use('Agg')\n" + blocks[1]
     code = code.replace('"scenes/', f'"{REPO}/scenes/')
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert done.returncode == 0, done.stderr

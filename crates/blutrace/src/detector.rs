@@ -240,7 +240,12 @@ impl TargetPlane {
     }
 
     /// The unit direction of view `k` (towards the viewer).
+    #[inline]
     pub fn view_dir(&self, k: usize) -> DVec3 {
+        // The normal view (the default) without trigonometry: every detection asks.
+        if self.views[k][0] == 0.0 {
+            return self.normal();
+        }
         let [theta, phi] = self.views[k].map(f64::to_radians);
         let tangent = self.u * phi.cos() + self.v * phi.sin();
         (self.normal() * theta.cos() + tangent * theta.sin()).normalize()
@@ -249,6 +254,9 @@ impl TargetPlane {
     /// The views (their indices, as a bit set) whose luminance cone holds `dir`.
     #[inline]
     pub fn cones_holding(&self, dir: DVec3) -> u64 {
+        if let [[0.0, _]] = self.views[..] {
+            return u64::from(dir.dot(self.normal()) >= self.cone_cos);
+        }
         (0..self.views.len())
             .filter(|&k| dir.dot(self.view_dir(k)) >= self.cone_cos)
             .fold(0, |set, k| set | 1 << k)

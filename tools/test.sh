@@ -19,11 +19,13 @@ fi
 
 scratch=$(mktemp -d "${TMPDIR:-/tmp}/blutrace-test-tmp.XXXXXX")
 trap 'rm -rf "$scratch"' EXIT
-# Files in the checkout beside the build's own folders, before and after the tests.
+# Files in the checkout beside the build's own folders (and the Python package's copy of
+# scenes/, which its build makes: python/build.rs), before and after the tests.
 checkout_files() {
   git status --porcelain --ignored --untracked-files=all -- . \
     ':(exclude)target' ':(exclude)third_party' ':(exclude)fuzz/target' \
-    ':(exclude)fuzz/corpus' ':(exclude)fuzz/artifacts' ':(exclude)fuzz/coverage' 2>/dev/null | sort
+    ':(exclude)fuzz/corpus' ':(exclude)fuzz/artifacts' ':(exclude)fuzz/coverage' \
+    ':(exclude)python/blutrace/_scenes' 2>/dev/null | sort
 }
 before=$(checkout_files)
 

@@ -299,15 +299,23 @@ impl<'a> Tracer<'a> {
         }
         let d = &self.scene.detector;
         let cones = d.cones_holding(dir);
+        if cones == 0 {
+            return;
+        }
+        let (bin, spectral) = (d.flux_index(ab) as u32, self.scene.sources.spectral());
+        let cause = match (p.covered, p.turned) {
+            (false, _) => p.cause,
+            (true, u32::MAX) => Cause::TurnedInWalk.index(self.places()),
+            (true, turned) => turned,
+        };
         for k in (0..d.views.len()).filter(|k| cones >> k & 1 == 1) {
-            let spectral = self.scene.sources.spectral().then_some(secondaries);
-            let at = (k as u16, d.flux_index(ab) as u32);
-            out.meter.push(MeterHit::new(at, weight, p.light, spectral));
-            let cause = match (p.covered, p.turned) {
-                (false, _) => p.cause,
-                (true, u32::MAX) => Cause::TurnedInWalk.index(self.places()),
-                (true, turned) => turned,
-            };
+            let hit = MeterHit::new(
+                (k as u16, bin),
+                weight,
+                p.light,
+                spectral.then_some(secondaries),
+            );
+            out.meter.push(hit);
             out.counted[cause as usize].add(weight);
         }
     }
@@ -433,6 +441,8 @@ impl<'a> Tracer<'a> {
             p.enters_scattering(medium);
             let (w, light, dir) = (&mut p.weight, p.light, true_ray.dir);
             let flight = flight::fly(medium, self.estimator, w, light, dir, t, eps, rng, sink);
+            // The secondaries cross what the hero did: the whole segment, or up to its
+            // scattering event.
             match flight {
                 Flight::Reached => p.crossed(p.medium, t, self.scene, self.estimator),
                 Flight::Scattered { t, .. } => p.crossed(p.medium, t, self.scene, self.estimator),

@@ -118,7 +118,9 @@ impl Tracer<'_> {
         out: &mut ChunkTally,
     ) {
         match v.model.meter_vertex(v.feature) {
-            MeterVertex::Specular => {
+            // Which face turned `n t` only names the cause of covered light: uncovered
+            // light has its cause already, and pays for no check.
+            MeterVertex::Specular if p.covered => {
                 if let Outcome::Scattered { dir, medium, .. } = *outcome {
                     let was = self.invariant(v.at.medium, v.at.dir, p.light);
                     let now = self.invariant(medium, dir, p.light);
@@ -127,6 +129,7 @@ impl Tracer<'_> {
                     }
                 }
             }
+            MeterVertex::Specular => {}
             MeterVertex::Diffuse => {
                 let tries = out.peel_tries[v.start];
                 // Giving a place up moves its light to the cone count: what the

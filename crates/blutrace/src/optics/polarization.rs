@@ -289,6 +289,46 @@ pub fn fresnel_roulette(
     }
 }
 
+/// The light of state `pol` along unit `dir` meeting the unit normal `facing` (from
+/// index `n1` to `n2`) and leaving by reflection (`reflect`) or by refraction: the
+/// fraction of its power that does (as [`fresnel_roulette`] draws it) and its state
+/// then, in the frame `u = s`; `None` for refraction beyond the critical angle.
+pub fn fresnel_branch(
+    dir: DVec3,
+    facing: DVec3,
+    (n1, n2): (f64, f64),
+    pol: &Polarization,
+    reflect: bool,
+) -> Option<(f64, Polarization)> {
+    let s = s_axis(dir, facing, pol.u);
+    let stokes = pol.stokes_in(dir, s);
+    let cos_i = -dir.dot(facing);
+    let r = fresnel_reflection(cos_i, n1, n2);
+    let m = match (reflect, fresnel_transmission(cos_i, n1, n2)) {
+        (true, _) => r,
+        (false, Some(t)) => t,
+        (false, None) => return None,
+    };
+    // The roulette's complement, so the two branches sum to one exactly.
+    let power = match reflect {
+        true => r.power_of(stokes).min(1.0),
+        false => 1.0 - r.power_of(stokes).min(1.0),
+    };
+    Some((power, Polarization::after(&m, stokes, s)))
+}
+
+/// What a detector's response `importance` (a Stokes-like vector carried backwards from
+/// the detector, along unit `-d`, in the frame `u`) makes of light of state `light`
+/// travelling along `d`: `sum I_i S_i` after the time reversal that turns the backward
+/// frame into the forward one (`v` and the phase reversed: `Q = diag(1, 1, -1, 1)`, for
+/// which a Fresnel matrix `M` of this module has the reversed light's matrix `Q M^T Q`: tested for Fresnel reflection, refraction and total
+/// internal reflection).
+pub fn response(importance: &Polarization, light: &Polarization, d: DVec3) -> f64 {
+    let s = light.stokes_in(d, importance.u).0;
+    let i = importance.stokes.0;
+    i[0] * s[0] + i[1] * s[1] - i[2] * s[2] + i[3] * s[3]
+}
+
 /// The state of light after a mirror of reflectance `r` (any `r`: the state is scaled
 /// back to unit power), reflected from unit `dir` at the unit normal `facing`.
 pub fn mirrored(pol: &Polarization, dir: DVec3, facing: DVec3) -> Polarization {

@@ -206,3 +206,85 @@ fn s_axis_and_block_direction() {
     assert!(close(b.dot(d), 0.0, 1e-15) && close(b.length(), 1.0, 1e-15));
     assert!(block_direction(DVec3::X, DVec3::X).is_none());
 }
+
+/// One event of a chain: the facet normal (towards the light met), the indices, and the
+/// branch taken.
+struct Event {
+    facing: DVec3,
+    n: (f64, f64),
+    reflect: bool,
+}
+
+/// The direction leaving event `e` for light along `d`.
+fn leave(d: DVec3, facing: DVec3, n: (f64, f64), reflect: bool) -> DVec3 {
+    match reflect {
+        true => crate::optics::fresnel::reflect(d, facing).normalize(),
+        false => crate::optics::fresnel::refract(d, facing, n.0, n.1).unwrap(),
+    }
+}
+
+/// A random chain of six Fresnel events from `d0`, and the direction it leaves along.
+fn random_chain(d0: DVec3, u: &mut impl FnMut() -> f64) -> (Vec<Event>, DVec3) {
+    let (mut d, mut inside, mut events) = (d0, false, Vec::new());
+    for _ in 0..6 {
+        let tilt = DVec3::new(u() - 0.5, u() - 0.5, u() - 0.5);
+        let facing = (-d + tilt).normalize();
+        let n = if inside { (1.58, 1.0) } else { (1.0, 1.58) };
+        let tir = crate::optics::fresnel::refract(d, facing, n.0, n.1).is_none();
+        let reflect = u() < 0.4 || tir;
+        d = leave(d, facing, n, reflect);
+        inside ^= !reflect;
+        events.push(Event { facing, n, reflect });
+    }
+    (events, d)
+}
+
+/// A polarized chain of Fresnel events read forwards (light) and backwards (a
+/// detector's response carried by the same functions) gives the same signal: the
+/// reciprocity [`response`] relies on, with total internal reflection's retardance
+/// turning S2 into S3 on the way.
+#[test]
+fn backward_response_through_fresnel_chains_matches_forward_light() {
+    let mut rng = crate::rng::PhotonRng::new(11, 3);
+    let mut u = || rng.uniform();
+    for chain in 0..200 {
+        let d0 = DVec3::new(u() - 0.5, u() - 0.5, u() - 0.5).normalize();
+        let (events, d_end) = random_chain(d0, &mut u);
+        let light = Polarization {
+            stokes: Stokes([1.0, 0.3 * u(), -0.5 * u(), 0.6 * u()]),
+            u: any_frame(d0),
+        };
+        let det = Polarization {
+            stokes: Stokes([1.0, 0.4, -0.3, 0.5]),
+            u: any_frame(d_end),
+        };
+        // Forwards: the light's power through each branch, then the detector's functional.
+        let (mut w, mut state, mut dir) = (1.0, light, d0);
+        for e in &events {
+            let (p, s) = fresnel_branch(dir, e.facing, e.n, &state, e.reflect).unwrap();
+            (w, state, dir) = (w * p, s, leave(dir, e.facing, e.n, e.reflect));
+        }
+        let (sf, di) = (state.stokes_in(dir, det.u).0, det.stokes.0);
+        let forward = w * (0..4).map(|i| di[i] * sf[i]).sum::<f64>();
+        // Backwards: the detector's vector, time-reversed, through the reversed events.
+        let mut imp = Polarization {
+            stokes: Stokes([di[0], di[1], -di[2], di[3]]),
+            u: det.u,
+        };
+        let (mut wb, mut back) = (1.0, -dir);
+        for e in events.iter().rev() {
+            let (facing, n) = match e.reflect {
+                true => (e.facing, e.n),
+                false => (-e.facing, (e.n.1, e.n.0)),
+            };
+            let (p, s) = fresnel_branch(back, facing, n, &imp, e.reflect).unwrap();
+            (wb, imp, back) = (wb * p, s, leave(back, facing, n, e.reflect));
+        }
+        assert!((back + d0).length() < 1e-9, "chain {chain}: the reversed path");
+        let backward = wb * response(&imp, &light, d0);
+        assert!(
+            (forward - backward).abs() < 1e-10,
+            "chain {chain}: forward {forward}, backward {backward}"
+        );
+    }
+}

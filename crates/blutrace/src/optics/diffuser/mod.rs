@@ -29,6 +29,8 @@
 //! The face is lossless (every photon is reflected or transmitted: the ledger stays
 //! exact) and `alpha -> 0` gives back the smooth Fresnel interface.
 
+pub mod density;
+
 use super::fresnel;
 use super::medium::{Interface, Medium, air};
 use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};

@@ -447,7 +447,7 @@ impl TargetPlane {
 
     /// The analyzer's axis made perpendicular to unit `dir` (`None`: no analyzer, or
     /// `dir` along its axis).
-    fn analyzer_axis(&self, dir: DVec3) -> Option<DVec3> {
+    pub fn analyzer_axis(&self, dir: DVec3) -> Option<DVec3> {
         let a = self.analyzer?;
         (a - a.dot(dir) * dir).try_normalize()
     }

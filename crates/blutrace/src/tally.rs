@@ -752,6 +752,9 @@ pub struct ChunkTally {
     /// Per place a peel-off starts from (each tag, then each lamp body), the peel-offs
     /// tried in this chunk and those that reached the target (the tracer's `meter`).
     pub peel_tries: Vec<[u32; 2]>,
+    /// The chunk's backward walks, reused by the meter's peel-offs (scratch, emptied
+    /// before the chunk is shipped: [`meter::PeelWalks`]).
+    pub peel_walks: meter::PeelWalks,
     /// Radiant weight the meter's peel-off scored, and what it counted in the cones by
     /// cause ([`MeterTally::counted`]).
     pub peeled: ExactSum,

@@ -20,6 +20,7 @@
 mod body_boxes;
 mod flight;
 mod meter;
+mod meter_walk;
 mod solid_walk;
 mod spectral;
 mod tir_run;
@@ -38,6 +39,7 @@ use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::sources::body::LampBody;
 use crate::tally::meter::Cause;
+use crate::tally::meter::PeelWalks;
 use crate::tally::{ChunkTally, Detection, ExactSum, Fate, Ledger, MeterHit};
 use body_boxes::BodyBoxes;
 use flight::Flight;
@@ -79,6 +81,8 @@ pub struct Tracer<'a> {
     luminance: Option<LuminanceEstimator>,
     /// Which wavelengths photons of spectral sources carry ([`spectral`]).
     wavelengths: spectral::Carried,
+    /// How the meter peels off ([`meter_walk`]).
+    walk: meter_walk::Walk,
 }
 
 /// A photon in flight.
@@ -141,6 +145,7 @@ impl<'a> Tracer<'a> {
             bodies,
             luminance: scene.luminous().then_some(LuminanceEstimator::Cone),
             wavelengths: spectral::Carried::Hero,
+            walk: meter_walk::Walk::of(scene),
         }
     }
 
@@ -233,7 +238,7 @@ impl<'a> Tracer<'a> {
                 return Fate::Escaped;
             };
             let model = self.model(struck, true_ray.dir, surf.normal);
-            let pol_out = Cell::new(None);
+            let (pol_out, shift_out) = (Cell::new(None), Cell::new(glam::DVec3::ZERO));
             let at = Arrival {
                 media: &scene.media,
                 hit: &surf,
@@ -243,6 +248,7 @@ impl<'a> Tracer<'a> {
                 light: p.light,
                 pol: p.pol,
                 pol_out: &pol_out,
+                shift_out: &shift_out,
             };
             let before = p.weight;
             let (outcome, feature) = model.interact_on(&at, rng);
@@ -266,7 +272,8 @@ impl<'a> Tracer<'a> {
                 } => {
                     p.reweigh(weight, struck.sink(&mut out.ledger));
                     p.scattered_by(model, feature, scene, self.estimator);
-                    p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
+                    let from = surf.point + shift_out.get();
+                    p.ray = SpawnedRay::leaving(from, surf.normal, dir, scene.spawn_eps);
                     p.medium = medium;
                     if p.pol.is_some() {
                         // A model that keeps no state leaves the light unpolarized.
@@ -475,6 +482,7 @@ impl<'a> Tracer<'a> {
             stokes: Vec::new(),
             meter: Vec::new(),
             peel_tries: vec![[0; 2]; self.places()],
+            peel_walks: PeelWalks::default(),
             peeled: ExactSum::default(),
             counted: vec![ExactSum::default(); self.places() + Cause::ALL.len()],
             ledger: Ledger::new(
@@ -487,6 +495,7 @@ impl<'a> Tracer<'a> {
             self.trace_photon(seed, i, &mut out);
         }
         out.ledger.sum_detected();
+        out.peel_walks = PeelWalks::default(); // scratch: not shipped
         out
     }
 }

@@ -9,7 +9,7 @@
 //! ```
 
 use super::medium::{Interface, Medium, MediumId, air};
-use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
 use crate::spec_check::Ctx;
@@ -49,6 +49,10 @@ impl Surface for Interface {
 
     fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
         MeterVertex::Specular
+    }
+
+    fn meter_layer(&self) -> MeterLayer {
+        MeterLayer::Flat
     }
 }
 

@@ -7,7 +7,7 @@
 //! ```
 
 use super::medium::Medium;
-use super::model::{Arrival, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::spectrum::{Range, Spectral, SpectralValue};
 use super::{fresnel, polarization};
 use crate::rng::PhotonRng;
@@ -61,6 +61,10 @@ impl Surface for Mirror {
 
     fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
         MeterVertex::Specular
+    }
+
+    fn meter_layer(&self) -> MeterLayer {
+        MeterLayer::Flat
     }
 }
 

@@ -56,6 +56,28 @@ pub trait Surface {
         0.0
     }
 
+    /// For a diffuse or stochastic event of the photon `at` that met `feature`: an
+    /// unbiased estimate of the density (per sr, the albedo included) that its light
+    /// leaves along unit `out`, weighted by `response` of the polarization it leaves with
+    /// (`None`: unpolarized, or polarization not traced). By default the density times the
+    /// response of unpolarized light (a model that leaves no state depolarizes).
+    fn meter_response(
+        &self,
+        at: &Arrival,
+        feature: Feature,
+        out: DVec3,
+        response: &dyn Fn(Option<&Polarization>) -> f64,
+        _rng: &mut PhotonRng,
+    ) -> f64 {
+        self.meter_density(at, feature, out) * response(None)
+    }
+
+    /// Whether the meter's backward walk crosses this model's face ([`MeterLayer`]). By
+    /// default not: its peel-off ends there.
+    fn meter_layer(&self) -> MeterLayer {
+        MeterLayer::Not
+    }
+
     /// Move the model's anchor points (a pattern's origin) with the scene by `by` (mm).
     fn translate(&mut self, _by: DVec3) {}
 
@@ -112,6 +134,10 @@ pub struct Arrival<'a> {
     /// state of the light that leaves; left `None`, the light leaves unpolarized (every
     /// diffuse model).
     pub pol_out: &'a Cell<Option<Polarization>>,
+    /// Where a model that traces a thin layer (grooves) puts the offset, in the face, from
+    /// the hit point to where the light's outgoing ray crosses the face (the light leaves
+    /// along that line); left zero, it leaves from the hit point.
+    pub shift_out: &'a Cell<DVec3>,
 }
 
 impl Arrival<'_> {
@@ -196,9 +222,29 @@ pub enum MeterVertex {
     /// A diffuse event whose density the model evaluates ([`Surface::meter_density`]):
     /// the peel-off starts there.
     Diffuse,
-    /// A scattering event whose density the model does not evaluate (a multiple-scattering
-    /// rough face, a measured table): the light it sends out is counted in the cone.
+    /// A scattering event whose density the model estimates without bias rather than
+    /// evaluates ([`Surface::meter_response`]: a rough face's walk): the backward peel-off
+    /// starts there; the flat-layer one counts its light in the cone.
+    Stochastic,
+    /// A scattering event whose density the model does not evaluate (a measured table):
+    /// the light it sends out is counted in the cone.
     Unevaluated,
+}
+
+/// What a model's face is to the meter's backward walk (`tracer::meter_walk`), which
+/// crosses layers the same at every point of the target from the target down to a
+/// diffuse event, then moves the path sideways to the event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeterLayer {
+    /// Not crossed: patterned (dots), diffuse, or not checked for the backward walk's
+    /// reciprocity (measured tables): the walk ends there with nothing.
+    Not,
+    /// Crossed: a face the same everywhere whose events keep `n t` (a smooth interface,
+    /// a mirror, a polarizer sheet).
+    Flat,
+    /// Crossed: a face the same everywhere (on the scale of the map's bins) whose
+    /// specular events turn `n t` (a prism film's uniform grooves).
+    Turning,
 }
 
 /// What part of a patterned face a hit met (see `SurfaceModel::interact_on`).

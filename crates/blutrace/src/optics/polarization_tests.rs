@@ -280,11 +280,45 @@ fn backward_response_through_fresnel_chains_matches_forward_light() {
             let (p, s) = fresnel_branch(back, facing, n, &imp, e.reflect).unwrap();
             (wb, imp, back) = (wb * p, s, leave(back, facing, n, e.reflect));
         }
-        assert!((back + d0).length() < 1e-9, "chain {chain}: the reversed path");
+        assert!(
+            (back + d0).length() < 1e-9,
+            "chain {chain}: the reversed path"
+        );
         let backward = wb * response(&imp, &light, d0);
         assert!(
             (forward - backward).abs() < 1e-10,
             "chain {chain}: forward {forward}, backward {backward}"
+        );
+    }
+}
+
+/// A polarizer sheet's transmission and reflection read forwards and backwards give the
+/// same signal (its matrices have the reversed light's form `Q M^T Q`), so the meter's
+/// backward walk may cross it.
+#[test]
+fn backward_response_through_polarizer_sheets_matches_forward_light() {
+    let d = DVec3::new(0.3, -0.2, 0.9).normalize();
+    let block = block_direction(d, DVec3::X).unwrap();
+    let light = Polarization {
+        stokes: Stokes([1.0, -0.2, 0.5, 0.3]),
+        u: any_frame(d),
+    };
+    let det = Stokes([1.0, 0.4, -0.3, 0.5]);
+    for m in [
+        polarizer_transmission(0.9, 0.02),
+        polarizer_reflection(0.05, 0.9),
+    ] {
+        let s = m.apply(light.stokes_in(d, block)).0;
+        let forward: f64 = (0..4).map(|i| det.0[i] * s[i]).sum();
+        let imp = Stokes([det.0[0], det.0[1], -det.0[2], det.0[3]]);
+        let back = Polarization {
+            stokes: m.apply(imp),
+            u: block,
+        };
+        let backward = response(&back, &light, d);
+        assert!(
+            (forward - backward).abs() < 1e-12,
+            "{forward} vs {backward}"
         );
     }
 }

@@ -29,7 +29,9 @@
 //! traces it.
 
 use super::medium::Medium;
-use super::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
+use super::model::{
+    Arrival, Face, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf,
+};
 use super::polarization::{
     Polarization, any_frame, block_direction, polarizer_reflection, polarizer_transmission,
 };
@@ -106,6 +108,12 @@ impl SurfaceSpecOf for PolarizerSpec {
 impl Surface for Polarizer {
     fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
         MeterVertex::Specular
+    }
+
+    /// The same everywhere and reciprocal (tested in `polarization`): the meter's
+    /// backward walk crosses it.
+    fn meter_layer(&self) -> MeterLayer {
+        MeterLayer::Flat
     }
 
     fn interact(&self, at: &Arrival, rng: &mut PhotonRng) -> (Outcome, Feature) {

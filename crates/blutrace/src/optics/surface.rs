@@ -41,7 +41,9 @@ use std::path::PathBuf;
 // Re-exported for the callers that name them along with the models (their homes are
 // `optics::model`, `optics::medium` and `crate::estimator`).
 pub use super::medium::{Interface, Medium, MediumId};
-pub use super::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
+pub use super::model::{
+    Arrival, Face, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf,
+};
 pub use crate::estimator::Estimator;
 
 /// Generates [`SurfaceModel`], [`SurfaceSpec`] and their dispatch from the registry.
@@ -83,6 +85,28 @@ macro_rules! surface_models {
             pub fn meter_density(&self, at: &Arrival, feature: Feature, out: DVec3) -> f64 {
                 match self {
                     $( SurfaceModel::$Variant(m) => m.meter_density(at, feature, out), )*
+                }
+            }
+
+            /// An estimate of a diffuse event's light leaving along `out`, weighted by
+            /// `response` of its polarization ([`Surface::meter_response`]).
+            pub fn meter_response(
+                &self,
+                at: &Arrival,
+                feature: Feature,
+                out: DVec3,
+                response: &dyn Fn(Option<&super::polarization::Polarization>) -> f64,
+                rng: &mut PhotonRng,
+            ) -> f64 {
+                match self {
+                    $( SurfaceModel::$Variant(m) => m.meter_response(at, feature, out, response, rng), )*
+                }
+            }
+
+            /// What the model's face is to the meter's backward walk.
+            pub fn meter_layer(&self) -> MeterLayer {
+                match self {
+                    $( SurfaceModel::$Variant(m) => m.meter_layer(), )*
                 }
             }
 
@@ -219,7 +243,10 @@ impl SurfaceModel {
         rng: &mut PhotonRng,
     ) -> Outcome {
         let light = Light::MONOCHROME;
-        let pol_out = std::cell::Cell::new(None);
+        let (pol_out, shift_out) = (
+            std::cell::Cell::new(None),
+            std::cell::Cell::new(DVec3::ZERO),
+        );
         let at = Arrival {
             media,
             hit,
@@ -229,6 +256,7 @@ impl SurfaceModel {
             light,
             pol: None,
             pol_out: &pol_out,
+            shift_out: &shift_out,
         };
         self.interact_on(&at, rng).0
     }

@@ -9,7 +9,9 @@
 //! bin many times.
 
 use super::{ExactSum, Grid, Sign};
+use crate::optics::polarization::Polarization;
 use crate::optics::spectrum::{Light, Secondaries};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// Per view, the meter's grids: one (the luminous weight) or, in a spectral run, X, Y, Z.
@@ -212,6 +214,40 @@ pub fn merge_photon_hits(hits: &mut Vec<MeterHit>, from: usize) {
         }
     }
     hits.truncate(kept + 1);
+}
+
+/// A backward walk of the meter's peel-off from the target down to a diffuse event's
+/// face (`tracer::meter_walk`), as the chunk keeps it for reuse.
+#[derive(Clone, Copy, Debug)]
+pub struct PeelWalk {
+    /// The direction drawn in the view's cone.
+    pub out: DVec3,
+    /// From the point the walk met the face to where it left the target.
+    pub shift: DVec3,
+    /// The forward light's direction at the face.
+    pub dir: DVec3,
+    /// The medium that direction runs in.
+    pub medium: crate::optics::medium::MediumId,
+    /// The walk's throughput (0: it met nothing it may end on).
+    pub weight: f64,
+    /// The detector's response carried back (polarization traced).
+    pub importance: Option<Polarization>,
+}
+
+/// One chunk's backward walks per (place, view): the first [`PeelWalks::SIZE`] peel-offs
+/// of a place draw theirs, later ones reuse them in turn. Every walk is drawn
+/// independently of the events that use it, so each event's estimate stays unbiased;
+/// events share walks only within a chunk, so chunks stay independent (the errors'
+/// jackknife holds).
+#[derive(Clone, Debug, Default)]
+pub struct PeelWalks {
+    /// Per `(place, view)` key, the walks drawn so far and how many uses they served.
+    pub lists: std::collections::HashMap<(usize, usize), (Vec<PeelWalk>, u32)>,
+}
+
+impl PeelWalks {
+    /// Walks a chunk draws per place and view.
+    pub const SIZE: usize = 1024;
 }
 
 #[cfg(test)]

@@ -45,6 +45,7 @@
 //! events they take one by one (ink, other models); their runs of total reflection keep
 //! `n t` by themselves.
 
+use super::meter_walk::Walk;
 use super::{Hit, Photon, Tracer};
 use crate::geometry::SpawnedRay;
 use crate::optics::model::{Arrival, MeterVertex};
@@ -85,7 +86,7 @@ const GIVE_UP_AFTER: u32 = 256;
 
 impl Tracer<'_> {
     /// The index of medium `m` for `light`.
-    fn index(&self, m: MediumId, light: Light) -> f64 {
+    pub(super) fn index(&self, m: MediumId, light: Light) -> f64 {
         self.scene.media[m as usize].index(light)
     }
 
@@ -104,7 +105,10 @@ impl Tracer<'_> {
                 .distance_squared(p.left_with)
                 <= KEPT * KEPT
         };
-        p.covered && p.medium == 0 && kept()
+        match self.walk {
+            Walk::Flat => p.covered && p.medium == 0 && kept(),
+            Walk::Backward => p.covered && p.medium == 0,
+        }
     }
 
     /// After an event of `v.model` that met `v.feature` and ended in `outcome`: at a
@@ -117,16 +121,26 @@ impl Tracer<'_> {
         outcome: &Outcome,
         out: &mut ChunkTally,
     ) {
-        match v.model.meter_vertex(v.feature) {
+        let kind = match (v.model.meter_vertex(v.feature), self.walk) {
+            (MeterVertex::Stochastic, Walk::Flat) => MeterVertex::Unevaluated,
+            (MeterVertex::Stochastic, Walk::Backward) => MeterVertex::Diffuse,
+            (kind, _) => kind,
+        };
+        match kind {
             // Which face turned `n t` only names the cause of covered light: uncovered
             // light has its cause already, and pays for no check.
-            MeterVertex::Specular if p.covered => {
+            MeterVertex::Specular if p.covered && self.walk == Walk::Flat => {
                 if let Outcome::Scattered { dir, medium, .. } = *outcome {
                     let was = self.invariant(v.at.medium, v.at.dir, p.light);
                     let now = self.invariant(medium, dir, p.light);
                     if was.distance_squared(now) > KEPT * KEPT {
                         p.turned = v.start as u32;
                     }
+                }
+            }
+            MeterVertex::Specular if p.covered => {
+                if !self.crosses(v.model.meter_layer(), v.at.hit.normal) {
+                    (p.covered, p.cause) = (false, v.start as u32);
                 }
             }
             MeterVertex::Specular => {}
@@ -142,7 +156,12 @@ impl Tracer<'_> {
                     return;
                 };
                 let before = out.meter.len();
-                self.peel(v, rng, &mut out.meter);
+                match self.walk {
+                    Walk::Flat => self.peel(v, rng, &mut out.meter),
+                    Walk::Backward => {
+                        self.peel_backward(v, rng, &mut out.peel_walks, &mut out.meter)
+                    }
+                }
                 for h in &out.meter[before..] {
                     out.peeled.add(h.weight);
                 }
@@ -154,24 +173,27 @@ impl Tracer<'_> {
                     p.left_with = self.invariant(medium, dir, p.light);
                 }
             }
-            MeterVertex::Unevaluated => (p.covered, p.cause) = (false, v.start as u32),
+            MeterVertex::Unevaluated | MeterVertex::Stochastic => {
+                (p.covered, p.cause) = (false, v.start as u32)
+            }
         }
     }
 
     /// [`Tracer::meter_event`] for the convex walk's event on `model` at `surf`, met along
-    /// `dir` in `medium` by `p` (of weight `before` then) that met `feature`.
+    /// `dir` in `medium` by `p` (of weight `before` and polarization `pol` then) that met
+    /// `feature`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn walk_event(
         &self,
         p: &mut Photon,
         (model, tag): (&SurfaceModel, u32),
         surf: &crate::geometry::SurfaceHit,
-        (dir, medium): (DVec3, MediumId),
+        (dir, medium, pol): (DVec3, MediumId, Option<Polarization>),
         (before, feature): (f64, Feature),
         outcome: &Outcome,
         out: &mut ChunkTally,
     ) {
-        let pol_out = Cell::new(None);
+        let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
         let at = Arrival {
             media: &self.scene.media,
             hit: surf,
@@ -179,8 +201,9 @@ impl Tracer<'_> {
             medium,
             est: self.estimator,
             light: p.light,
-            pol: None,
+            pol,
             pol_out: &pol_out,
+            shift_out: &shift_out,
         };
         let v = Vertex {
             at: &at,
@@ -288,7 +311,7 @@ impl Tracer<'_> {
             }
             let Hit { surf, struck } = surf?;
             let model = self.model(struck, true_ray.dir, surf.normal);
-            let pol_out = Cell::new(None);
+            let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
             let met = Arrival {
                 media: &scene.media,
                 hit: &surf,
@@ -298,6 +321,7 @@ impl Tracer<'_> {
                 light: p.light,
                 pol: p.pol,
                 pol_out: &pol_out,
+                shift_out: &shift_out,
             };
             let (outcome, feature) = model.interact_on(&met, rng);
             let Outcome::Scattered {
@@ -312,7 +336,8 @@ impl Tracer<'_> {
                 return None;
             }
             p.weight *= weight;
-            p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
+            let from = surf.point + shift_out.get();
+            p.ray = SpawnedRay::leaving(from, surf.normal, dir, scene.spawn_eps);
             p.medium = medium;
             if p.pol.is_some() {
                 p.pol = Some(pol_out.get().unwrap_or(Polarization::unpolarized(dir)));
@@ -322,7 +347,7 @@ impl Tracer<'_> {
     }
 
     /// The fraction of light crossing `t` mm of medium `m` unabsorbed and unscattered.
-    fn transmittance(&self, m: MediumId, light: Light, t: f64) -> f64 {
+    pub(super) fn transmittance(&self, m: MediumId, light: Light, t: f64) -> f64 {
         let medium = &self.scene.media[m as usize];
         let scattering = match medium.scattering.scatters() {
             true => medium.scattering.coefficient(light),
@@ -334,7 +359,7 @@ impl Tracer<'_> {
 }
 
 /// A direction drawn uniformly (in solid angle) within `half_deg` of unit `axis`.
-fn in_cone(axis: DVec3, half_deg: f64, rng: &mut PhotonRng) -> DVec3 {
+pub(super) fn in_cone(axis: DVec3, half_deg: f64, rng: &mut PhotonRng) -> DVec3 {
     // 1 - cos c without cancellation, as the cone's solid angle takes it.
     let margin = 2.0 * (half_deg.to_radians() / 2.0).sin().powi(2);
     let cos_a = 1.0 - rng.uniform() * margin;

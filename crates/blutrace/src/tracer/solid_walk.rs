@@ -42,6 +42,7 @@ use crate::rng::PhotonRng;
 use crate::scene::Scene;
 use crate::tally::{ChunkTally, Fate};
 use glam::DVec3;
+use std::cell::Cell;
 
 /// A tag's surface model as the walk takes it.
 #[derive(Clone, Debug)]
@@ -162,8 +163,8 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: facet.normal,
             };
-            let (light, before) = (p.light, p.weight);
-            let (outcome, feature) =
+            let (light, before, pol_before) = (p.light, p.weight, p.pol);
+            let (outcome, feature, shift) =
                 self.face_step(tag, &surf, (ray.dir, medium, light), &mut p.pol, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
             if self.luminance == Some(LuminanceEstimator::Meter) {
@@ -173,7 +174,7 @@ impl Tracer<'_> {
                     p,
                     (model, tag),
                     &surf,
-                    (ray.dir, medium),
+                    (ray.dir, medium, pol_before),
                     event,
                     &outcome,
                     out,
@@ -190,12 +191,13 @@ impl Tracer<'_> {
             p.reweigh(weight, &mut out.ledger.absorbed_by_surface[tag as usize]);
             let model = &scene.surfaces[tag as usize];
             p.scattered_by(model, feature, scene, self.estimator);
-            ray = Ray::new(surf.point, dir);
+            let from = surf.point + shift;
+            ray = Ray::new(from, dir);
             if !roulette(p, rng, &mut out.ledger) {
                 return Some(Fate::Roulette);
             }
             if next != medium {
-                p.ray = SpawnedRay::leaving(surf.point, surf.normal, dir, scene.spawn_eps);
+                p.ray = SpawnedRay::leaving(from, surf.normal, dir, scene.spawn_eps);
                 p.medium = next;
                 return None;
             }
@@ -233,6 +235,7 @@ impl Tracer<'_> {
         if let Some(pol) = &mut p.pol {
             run.retard(pol, dir, &s, p.light);
         }
+        self.meter_run(p, run, &s);
         if p.secondaries.live() {
             if run.dispersive() {
                 p.secondaries.end();
@@ -258,7 +261,8 @@ impl Tracer<'_> {
     /// The face of tag `tag` met at `surf` along `dir` by a photon in `medium`: what
     /// [`SurfaceModel::interact_on`] does (and returns), the guide's two faces taken
     /// directly.
-    /// `pol`, the photon's polarization when it is traced, becomes the light's that leaves.
+    /// `pol`, the photon's polarization when it is traced, becomes the light's that leaves;
+    /// the offset returned moves where it leaves from (`Arrival::shift_out`).
     fn face_step(
         &self,
         tag: u32,
@@ -266,13 +270,15 @@ impl Tracer<'_> {
         (dir, medium, light): (DVec3, MediumId, Light),
         pol: &mut Option<Polarization>,
         rng: &mut PhotonRng,
-    ) -> (Outcome, Feature) {
+    ) -> (Outcome, Feature, DVec3) {
         // As interact_on and dielectric::scatter decide it (NaN counts as leaving).
         let entering = dir.dot(surf.normal) < 0.0;
         match &self.walks.faces[tag as usize] {
-            Face::Smooth(s) if !entering => {
-                (s.leave(surf.normal, dir, light, pol, rng), Feature::Plain)
-            }
+            Face::Smooth(s) if !entering => (
+                s.leave(surf.normal, dir, light, pol, rng),
+                Feature::Plain,
+                DVec3::ZERO,
+            ),
             Face::Dotted {
                 smooth,
                 pattern,
@@ -287,15 +293,16 @@ impl Tracer<'_> {
                     let albedo = ink_albedo.at(light);
                     let outcome = ink(albedo, -surf.normal, medium, self.estimator, rng);
                     carry(pol, &outcome, None);
-                    return (outcome, Feature::Ink);
+                    return (outcome, Feature::Ink, DVec3::ZERO);
                 }
                 (
                     smooth.leave(surf.normal, dir, light, pol, rng),
                     Feature::Plain,
+                    DVec3::ZERO,
                 )
             }
             _ => {
-                let pol_out = std::cell::Cell::new(None);
+                let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
                 let at = Arrival {
                     media: &self.scene.media,
                     hit: surf,
@@ -305,12 +312,13 @@ impl Tracer<'_> {
                     light,
                     pol: *pol,
                     pol_out: &pol_out,
+                    shift_out: &shift_out,
                 };
                 // No back to choose: a solid's faces are interfaces, which have none
                 // (`optics::two_sided`).
                 let (outcome, feature) = self.scene.surfaces[tag as usize].interact_on(&at, rng);
                 carry(pol, &outcome, pol_out.get());
-                (outcome, feature)
+                (outcome, feature, shift_out.get())
             }
         }
     }

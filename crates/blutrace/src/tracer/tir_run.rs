@@ -80,6 +80,15 @@ pub(super) struct Skipped {
     pub(super) length: f64,
 }
 
+impl TirRun<'_> {
+    /// The unit thickness axis: the faces' normal (up to sign).
+    pub(super) fn axis(&self) -> DVec3 {
+        let mut a = DVec3::ZERO;
+        a[self.k] = 1.0;
+        a
+    }
+}
+
 impl Skipped {
     /// Reflections at the plain face.
     pub(super) fn plain_hits(&self) -> u32 {

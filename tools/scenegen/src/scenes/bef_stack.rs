@@ -123,6 +123,9 @@ axis = {a}
     tables
 }
 
+/// The LED bar's luminous flux (lm): see the scene's header.
+const LUMENS: f64 = 300.0;
+
 fn scene_toml(triangles: usize) -> String {
     let [gx, gy, gz] = GUIDE;
     let [dz, dt] = DIFFUSER;
@@ -137,7 +140,9 @@ reflector sheet, dotted light guide, surface diffuser sheet, two crossed prism f
   density {d0} + {d2} x^2 (x = distance from the lit edge / {gx} mm).
 - Reflector sheet (tag reflector_sheet, Lambertian, albedo 0.95): z = {sz}, under the guide.
 - LED bar: {lw} x {lh} mm (y x z), Lambertian, 1 W, centre {c}, facing +x, in a mirror housing
-  (tag lamp_reflector, reflectance 0.95) x {hd}..0 round the guide's x = 0 edge.
+  (tag lamp_reflector, reflectance 0.95) x {hd}..0 round the guide's x = 0 edge. 300 lm (an
+  assumption for the luminance maps: a white LED's spectrum gives about 300 lm per radiant
+  watt, as phone-led's table gives 306 and notebook14-color's FL11 spectrum 337).
 - Diffuser sheet: PET n = {N_PET}, z {dz}..{dtop}, same footprint. Top face (diffuser_top) rough:
   model \"diffuser\", GGX roughness {ROUGHNESS}; back and edges smooth.
 - Prism films bef1 (z {b1}..{b1t}) and bef2 (z {b2}..{b2t}): PET n = {N_PET}, base {BEF_T} mm thick, top face
@@ -197,7 +202,11 @@ Geometry: bef-stack.obj and bef-films.obj (usemtl names are tags), {triangles} t
     tables.push(dielectric("diffuser_back", "pet_diffuser"));
     tables.push(dielectric("diffuser_edge", "pet_diffuser"));
     tables.extend(film_surfaces());
-    tables.push(Led::facing_x("led_bar", led(), LED).toml());
+    let bar = Led {
+        lumens: Some(LUMENS),
+        ..Led::facing_x("led_bar", led(), LED)
+    };
+    tables.push(bar.toml());
     tables.push(Detector::new([0.0, 0.0, DETECTOR_Z], [gx, gy], [20, 15]).toml());
     tables.push(trace_table(200_000, 100_000));
     scene_file(&header, &tables)

@@ -117,8 +117,8 @@ impl Face {
             true => 1.0 / (4.0 * cos_o.abs()),
             false => n2 * n2 * cos_o.abs() / (n1 * cos_i + n2 * cos_o).powi(2),
         };
-        let visible = g1(wi, facing, self.alpha) * cos_i * ggx(m, facing, self.alpha)
-            / wi.dot(facing);
+        let visible =
+            g1(wi, facing, self.alpha) * cos_i * ggx(m, facing, self.alpha) / wi.dot(facing);
         let branch = match &s.pol {
             Some(p) => fresnel_branch(s.dir, m, (n1, n2), p, reflect)
                 .map(|(power, after)| power * response(Some(&after))),

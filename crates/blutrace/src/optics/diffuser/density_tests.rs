@@ -33,7 +33,14 @@ fn check(face: Face, dir: DVec3, pol: Option<Polarization>) {
     for i in 0..n {
         let mut rng = PhotonRng::new(21, i);
         let mut p = pol;
-        let (d, _) = scatter_carrying(face.alpha, face.indices, face.normal, dir, p.as_mut(), &mut rng);
+        let (d, _) = scatter_carrying(
+            face.alpha,
+            face.indices,
+            face.normal,
+            dir,
+            p.as_mut(),
+            &mut rng,
+        );
         counts[bin_of(d)] += 1.0;
     }
     let omega = 4.0 * PI / (BANDS * SECTORS) as f64;

@@ -33,7 +33,7 @@ pub mod density;
 
 use super::fresnel;
 use super::medium::{Interface, Medium, air};
-use super::model::{Arrival, Feature, Outcome, Surface, SurfaceSpecOf};
+use super::model::{Arrival, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf};
 use super::polarization::{Polarization, fresnel_roulette};
 use crate::geometry::orthonormal_basis;
 use crate::rng::PhotonRng;
@@ -82,6 +82,38 @@ impl Surface for Diffuser {
 
     fn interface(&self) -> Option<Interface> {
         Some(self.interface)
+    }
+
+    /// A rough face's walk has no closed-form density: the meter estimates it
+    /// ([`density`]); a smooth one is a plain interface.
+    fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
+        match self.roughness > 0.0 {
+            true => MeterVertex::Stochastic,
+            false => MeterVertex::Specular,
+        }
+    }
+
+    fn meter_layer(&self) -> MeterLayer {
+        match self.roughness > 0.0 {
+            true => MeterLayer::Not,
+            false => MeterLayer::Flat,
+        }
+    }
+
+    fn meter_response(
+        &self,
+        at: &Arrival,
+        _feature: Feature,
+        out: DVec3,
+        response: &dyn Fn(Option<&Polarization>) -> f64,
+        rng: &mut PhotonRng,
+    ) -> f64 {
+        let face = density::Face {
+            alpha: self.roughness,
+            indices: at.indices(&self.interface),
+            normal: at.hit.normal,
+        };
+        face.exit_density(at.dir, at.pol, out, response, rng)
     }
 }
 

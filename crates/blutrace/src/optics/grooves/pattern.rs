@@ -255,11 +255,15 @@ impl GroovePattern {
         rng: &mut PhotonRng,
     ) -> Option<(DVec3, bool)> {
         self.scatter_met(indices, point, normal, dir, None, rng)
-            .map(|(d, inside, _)| (d, inside))
+            .map(|(d, inside, _, _)| (d, inside))
     }
 
     /// [`GroovePattern::scatter`], also saying whether the path met a facet of a groove
-    /// (`false`: it met only the flat land between grooves); `pol`, when polarization is
+    /// (`false`: it met only the flat land between grooves), and how far along `axis`
+    /// from `point` its outgoing ray crosses the mean plane (where the light leaves from:
+    /// the line it really leaves along, so that the reversed light, rewound along that
+    /// line, re-enters the layer where it left; tracing reversed paths backwards, as the
+    /// luminance meter does, meets the relief as photons do); `pol`, when polarization is
     /// traced, is carried through every facet's Fresnel event.
     pub fn scatter_met(
         &self,
@@ -269,7 +273,7 @@ impl GroovePattern {
         dir: DVec3,
         mut pol: Option<&mut Polarization>,
         rng: &mut PhotonRng,
-    ) -> Option<(DVec3, bool, bool)> {
+    ) -> Option<(DVec3, bool, bool, f64)> {
         let mut met = false;
         let axis = self.axis;
         let (ds0, dz0) = (dir.dot(axis), dir.dot(normal));
@@ -308,7 +312,8 @@ impl GroovePattern {
             else {
                 // Left the layer; a missed crossing (a ray exactly through a vertex) could
                 // leave side and direction inconsistent: the direction decides.
-                return (dz != 0.0).then_some((d, dz < 0.0, met));
+                let shift = at.0 - ds * at.1 / dz - s_hit;
+                return (dz != 0.0).then_some((d, dz < 0.0, met, shift));
             };
             // Segments 1 and 2 are the V's facets, 0 and 3 the lands either side.
             met |= c.seg == 1 || c.seg == 2;

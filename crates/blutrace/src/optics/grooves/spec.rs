@@ -7,7 +7,9 @@ use crate::optics::density::{
 };
 use crate::optics::dielectric;
 use crate::optics::medium::{Interface, Medium, air};
-use crate::optics::model::{Arrival, Face, Feature, MeterVertex, Outcome, Surface, SurfaceSpecOf};
+use crate::optics::model::{
+    Arrival, Face, Feature, MeterLayer, MeterVertex, Outcome, Surface, SurfaceSpecOf,
+};
 use crate::rng::PhotonRng;
 use crate::spec_check::{Ctx, short};
 
@@ -71,10 +73,20 @@ pub struct Grooves {
 
 impl Surface for Grooves {
     /// Facets and the flat between them are specular; a facet turns the light's
-    /// direction across the face, which the meter's peel-off path notices and leaves to
-    /// the cone count.
+    /// direction across the face, which the flat-layer peel-off path notices and leaves
+    /// to the cone count, and which the backward walk crosses.
     fn meter_vertex(&self, _feature: Feature) -> MeterVertex {
         MeterVertex::Specular
+    }
+
+    /// Uniform grooves (a prism film) are the same at every point on the scale of a
+    /// map's bins (many pitches to a bin): the backward walk crosses them, meeting them
+    /// at whatever phase its path has. Graded ones are a pattern.
+    fn meter_layer(&self) -> MeterLayer {
+        match self.pattern.fill.is_constant() {
+            true => MeterLayer::Turning,
+            false => MeterLayer::Not,
+        }
     }
 
     #[inline]
@@ -84,8 +96,9 @@ impl Surface for Grooves {
         let mut pol = at.pol;
         let (point, normal) = (at.hit.point, at.hit.normal);
         match p.scatter_met(at.indices(i), point, normal, at.dir, pol.as_mut(), rng) {
-            Some((d, inside, met)) => {
+            Some((d, inside, met, shift)) => {
                 at.pol_out.set(pol);
+                at.shift_out.set(p.axis * shift);
                 let feature = if met { Feature::Groove } else { Feature::Plain };
                 (at.lossless(i, (d, inside)), feature)
             }

@@ -107,8 +107,8 @@ fn a_lambertian_floor_reads_albedo_e_over_pi_from_every_view() {
 /// `name` at a reduced size (`bins`, a 10 degree cone so the cone count converges at a
 /// million photons, the normal and a slanted view): the meter and the cone count agree
 /// in the mean and bin by bin (chi-square at 4 sigma over the bins, each difference over
-/// both errors), and the meter's errors are several times smaller.
-fn agrees_with_the_cone_count(name: &str, bins: [usize; 2], slant: f64, photons: u64) {
+/// both errors), and the meter's error of the mean is `gain` times smaller or more.
+fn agrees_with_the_cone_count(name: &str, bins: [usize; 2], slant: f64, photons: u64, gain: f64) {
     let mut scene = support::load(&support::repo_scene(name));
     scene.detector.bins = bins;
     scene.detector.views = vec![[0.0, 0.0], [slant, 0.0]];
@@ -137,20 +137,24 @@ fn agrees_with_the_cone_count(name: &str, bins: [usize; 2], slant: f64, photons:
         println!("{name} view {k}: meter {a:?}, cone {b:?}");
         let z = (a.value - b.value) / (a.stderr.powi(2) + b.stderr.powi(2)).sqrt();
         assert!(z.abs() < 4.0, "{name} view {k}: {a:?} vs {b:?}");
-        assert!(a.stderr < b.stderr / 3.0, "{name} view {k}: {a:?} vs {b:?}");
+        assert!(
+            a.stderr < b.stderr / gain,
+            "{name} view {k}: {a:?} vs {b:?}"
+        );
     }
 }
 
 /// Dots under flat layers: the flat-layer peel-off.
 #[test]
 fn the_meter_agrees_with_the_cone_count_on_notebook14() {
-    agrees_with_the_cone_count("notebook14", [10, 10], 40.0, 1_000_000);
+    agrees_with_the_cone_count("notebook14", [10, 10], 40.0, 1_000_000, 3.0);
 }
 
-/// A rough diffuser under two crossed prism films: the backward walk, polarized.
+/// A rough diffuser under two crossed prism films: the backward walk, polarized (its
+/// walks, which succeed or not, make the mean's error less small than the bins').
 #[test]
 fn the_meter_agrees_with_the_cone_count_on_bef_stack() {
-    agrees_with_the_cone_count("bef-stack", [8, 6], 30.0, 600_000);
+    agrees_with_the_cone_count("bef-stack", [8, 6], 30.0, 600_000, 1.5);
 }
 
 /// The peel-off draws from the photons' side streams: under either estimator the

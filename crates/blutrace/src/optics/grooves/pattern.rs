@@ -421,6 +421,29 @@ mod tests {
     }
 
     #[test]
+    fn reversed_paths_retrace_the_relief_from_where_light_left() {
+        // Near-normal light under BEF prisms comes back by two total reflections (no
+        // roulette). Sent back along its outgoing ray, from where that ray crosses the
+        // mean plane, it must retrace the same facets: out along the reversed incoming
+        // direction, from the point it first met the plane.
+        let p = pattern(Relief::Raised, 90.0, 0.0, Gradation::constant(1.0));
+        let mut rng = PhotonRng::new(2, 9);
+        for i in 0..500 {
+            let tilt = 5f64.to_radians() * (2.0 * rng.uniform() - 1.0);
+            let a = DVec3::new(tilt.sin(), 0.0, tilt.cos());
+            let point = DVec3::new(p.pitch * 37.0 * rng.uniform(), 0.3, 0.0);
+            let (d, inside, _, shift) =
+                p.scatter_met((1.58, 1.0), point, DVec3::Z, a, None, &mut rng).unwrap();
+            assert!(inside, "path {i}");
+            let back = point + DVec3::X * shift;
+            let (d2, inside2, _, shift2) =
+                p.scatter_met((1.58, 1.0), back, DVec3::Z, -d, None, &mut rng).unwrap();
+            assert!(inside2 && (d2 + a).length() < 1e-9, "path {i}: {d2:?} vs {:?}", -a);
+            assert!((back.x + shift2 - point.x).abs() < 1e-9 * p.pitch, "path {i}");
+        }
+    }
+
+    #[test]
     fn lamp_facing_facet_totally_reflects_guided_light_towards_the_front() {
         // A cut 45/25 deg groove on a guide's back face (normal -z, guide above): light
         // travelling along +x, 2 deg towards the back face, meets the 45 deg facet at

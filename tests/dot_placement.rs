@@ -572,6 +572,7 @@ fn walk(scene: &Scene, pitch: f64, random_phase: bool, photons: u64) -> (f64, f6
                 light: Light::MONOCHROME,
                 pol: None,
                 pol_out: &std::cell::Cell::new(None),
+                shift_out: &std::cell::Cell::new(DVec3::ZERO),
             };
             let (out, feature) = model.interact_on(&at, &mut rng);
             if z == 0.0 {

@@ -46,7 +46,7 @@ fn check(face: Face, dir: DVec3, pol: Option<Polarization>) {
     let omega = 4.0 * PI / (BANDS * SECTORS) as f64;
     let k = 3000u64;
     let (mut total, mut total_var) = (0.0, 0.0);
-    for b in 0..BANDS * SECTORS {
+    for (b, &count) in counts.iter().enumerate() {
         let mut rng = PhotonRng::new(22, b as u64);
         let (mut s, mut s2) = (0.0, 0.0);
         for _ in 0..k {
@@ -56,7 +56,7 @@ fn check(face: Face, dir: DVec3, pol: Option<Polarization>) {
         }
         let mean = s / k as f64;
         let var_est = (s2 / k as f64 - mean * mean).max(0.0) / k as f64;
-        let frac = counts[b] / n as f64;
+        let frac = count / n as f64;
         let var_hist = frac * (1.0 - frac) / n as f64;
         let sigma = (var_est + var_hist).sqrt().max(1e-12);
         assert!(

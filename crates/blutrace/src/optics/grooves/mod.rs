@@ -57,10 +57,12 @@
 //! reflection of a BEF's prisms are all exact.
 //!
 //! Approximations, each small when the relief is small against the part it sits on:
-//! - *thin layer*: the photon leaves the surface from the point where it met the mean
-//!   plane (the tracer's rule), not from where it left the relief: a displacement of up to
-//!   `H` across the face and about `H cot(beta)` along it (beta: the photon's angle to the
-//!   face), which moves where light comes out, not what happens to it;
+//! - *thin layer*: the photon leaves the surface from the point where its outgoing ray
+//!   crosses the mean plane, not from where it left the relief (up to `H` away across the
+//!   face): the line it leaves along is exact. That point, unlike the one where it met the
+//!   mean plane, makes the model reversible: light sent back along its outgoing ray is
+//!   rewound into the relief where it left it, as the luminance meter's backward walk
+//!   needs (`tracer::meter_walk`);
 //! - the relief is met only where a photon's path reaches the mean plane: near the face's
 //!   border, a grazing photon that the real relief would catch up to `H cot(beta)` before
 //!   the border reaches the neighbouring face instead;

@@ -81,8 +81,8 @@ pub struct Tracer<'a> {
     luminance: Option<LuminanceEstimator>,
     /// Which wavelengths photons of spectral sources carry ([`spectral`]).
     wavelengths: spectral::Carried,
-    /// How the meter peels off ([`meter_walk`]).
-    walk: meter_walk::Walk,
+    /// How the meter peels off ([`meter::Walk`]).
+    walk: meter::Walk,
 }
 
 /// A photon in flight.
@@ -145,7 +145,7 @@ impl<'a> Tracer<'a> {
             bodies,
             luminance: scene.luminous().then_some(LuminanceEstimator::Cone),
             wavelengths: spectral::Carried::Hero,
-            walk: meter_walk::Walk::of(scene),
+            walk: meter::Walk::of(scene),
         }
     }
 

@@ -45,15 +45,15 @@
 //! events they take one by one (ink, other models); their runs of total reflection keep
 //! `n t` by themselves.
 
-use super::meter_walk::Walk;
 use super::{Hit, Photon, Tracer};
 use crate::geometry::SpawnedRay;
-use crate::optics::model::{Arrival, MeterVertex};
+use crate::optics::model::{Arrival, MeterLayer, MeterVertex};
 use crate::optics::polarization::Polarization;
 use crate::optics::sampling;
 use crate::optics::spectrum::{Light, Secondaries};
 use crate::optics::surface::{Estimator, Feature, MediumId, Outcome, SurfaceModel};
 use crate::rng::PhotonRng;
+use crate::scene::Scene;
 use crate::tally::{ChunkTally, MeterHit};
 use glam::DVec3;
 use std::cell::Cell;
@@ -83,6 +83,30 @@ pub(super) struct Vertex<'a> {
 /// Peel-offs from one place that all miss the target before the place is given up for
 /// the rest of the chunk (a lamp cavity's reflector seen through its own housing).
 const GIVE_UP_AFTER: u32 = 256;
+
+/// How the meter peels off in a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Walk {
+    /// Forward through faces keeping `n t` (this module).
+    Flat,
+    /// Backward through uniform layers ([`super::meter_walk`]).
+    Backward,
+}
+
+impl Walk {
+    /// Backward when the scene has uniform grooves or a rough diffuser, else flat.
+    pub(super) fn of(scene: &Scene) -> Walk {
+        let backward = scene
+            .surfaces
+            .iter()
+            .chain(scene.backs.iter().flatten())
+            .any(|m| {
+                m.meter_layer() == MeterLayer::Turning
+                    || m.meter_vertex(Feature::Plain) == MeterVertex::Stochastic
+            });
+        if backward { Walk::Backward } else { Walk::Flat }
+    }
+}
 
 impl Tracer<'_> {
     /// The index of medium `m` for `light`.

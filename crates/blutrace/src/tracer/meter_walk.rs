@@ -46,15 +46,15 @@
 //! the phase the moved path has, not the one the event's own light would meet (a map's
 //! bin spans many pitches).
 
+use super::meter::{Vertex, Walk, in_cone};
 use super::tir_run::{Skipped, TirRun};
 use super::{Photon, Tracer};
 use crate::geometry::{Ray, SpawnedRay};
-use crate::optics::model::{Arrival, MeterLayer, MeterVertex};
+use crate::optics::model::{Arrival, MeterLayer};
 use crate::optics::polarization::{Polarization, Stokes, response};
 use crate::optics::spectrum::{Light, Secondaries};
-use crate::optics::surface::{Estimator, Feature, Outcome};
+use crate::optics::surface::{Estimator, Outcome};
 use crate::rng::PhotonRng;
-use crate::scene::Scene;
 use crate::tally::MeterHit;
 use crate::tally::meter::{PeelWalk, PeelWalks};
 use glam::DVec3;
@@ -65,30 +65,6 @@ const WALK_EVENTS: u32 = 256;
 
 /// How parallel to the target a face must be for the backward walk to cross it.
 const PARALLEL: f64 = 1e-9;
-
-/// How the meter peels off in a scene.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Walk {
-    /// Forward through faces keeping `n t` ([`super::meter`]).
-    Flat,
-    /// Backward through uniform layers (this module).
-    Backward,
-}
-
-impl Walk {
-    /// Backward when the scene has uniform grooves or a rough diffuser, else flat.
-    pub(super) fn of(scene: &Scene) -> Walk {
-        let backward = scene
-            .surfaces
-            .iter()
-            .chain(scene.backs.iter().flatten())
-            .any(|m| {
-                m.meter_layer() == MeterLayer::Turning
-                    || m.meter_vertex(Feature::Plain) == MeterVertex::Stochastic
-            });
-        if backward { Walk::Backward } else { Walk::Flat }
-    }
-}
 
 impl Tracer<'_> {
     /// Whether the backward walk crosses `model`'s face met at unit `normal`.
@@ -115,7 +91,7 @@ impl Tracer<'_> {
     /// reused: [`PeelWalks`]).
     pub(super) fn peel_backward(
         &self,
-        v: &super::meter::Vertex,
+        v: &Vertex,
         rng: &mut PhotonRng,
         pool: &mut PeelWalks,
         hits: &mut Vec<MeterHit>,
@@ -158,7 +134,7 @@ impl Tracer<'_> {
     /// [`PeelWalks::SIZE`].
     fn pooled_walk(
         &self,
-        v: &super::meter::Vertex,
+        v: &Vertex,
         k: usize,
         rng: &mut PhotonRng,
         pool: &mut PeelWalks,
@@ -176,11 +152,11 @@ impl Tracer<'_> {
     /// middle half (each way): the walk stands for every event of its place, so it
     /// starts away from the layers' ends, and at a random phase of any periodic
     /// structure it meets (a fixed start would meet prisms at one phase only).
-    fn draw_walk(&self, v: &super::meter::Vertex, k: usize, rng: &mut PhotonRng) -> PeelWalk {
+    fn draw_walk(&self, v: &Vertex, k: usize, rng: &mut PhotonRng) -> PeelWalk {
         let d = &self.scene.detector;
         let (a, b) = (0.25 + 0.5 * rng.uniform(), 0.25 + 0.5 * rng.uniform());
         let start = d.origin + d.u * (a * d.size[0]) + d.v * (b * d.size[1]);
-        let out = super::meter::in_cone(d.view_dir(k), d.luminance_cone_deg, rng);
+        let out = in_cone(d.view_dir(k), d.luminance_cone_deg, rng);
         let nothing = PeelWalk {
             out,
             shift: DVec3::ZERO,
@@ -202,7 +178,7 @@ impl Tracer<'_> {
         &self,
         start: DVec3,
         out: DVec3,
-        v: &super::meter::Vertex,
+        v: &Vertex,
         rng: &mut PhotonRng,
     ) -> Option<PeelWalk> {
         let scene = self.scene;

@@ -335,39 +335,54 @@ impl Tracer<'_> {
             }
             let Hit { surf, struck } = surf?;
             let model = self.model(struck, true_ray.dir, surf.normal);
-            let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
-            let met = Arrival {
-                media: &scene.media,
-                hit: &surf,
-                dir: true_ray.dir,
-                medium: p.medium,
-                est: Estimator::Weighted,
-                light: p.light,
-                pol: p.pol,
-                pol_out: &pol_out,
-                shift_out: &shift_out,
-            };
-            let (outcome, feature) = model.interact_on(&met, rng);
-            let Outcome::Scattered {
-                dir,
-                medium,
-                weight,
-            } = outcome
-            else {
-                return None;
-            };
+            let feature = self.path_step(&mut p, model, &surf, true_ray.dir, rng)?;
             if model.meter_vertex(feature) != MeterVertex::Specular {
                 return None;
             }
-            p.weight *= weight;
-            let from = surf.point + shift_out.get();
-            p.ray = SpawnedRay::leaving(from, surf.normal, dir, scene.spawn_eps);
-            p.medium = medium;
-            if p.pol.is_some() {
-                p.pol = Some(pol_out.get().unwrap_or(Polarization::unpolarized(dir)));
-            }
         }
         None
+    }
+
+    /// One event of a peel-off path (traced either way) at `surf`, met along `dir`: `p`
+    /// takes the model's outcome with weights for absorption; what part of the face it
+    /// met, `None` when the path ends there.
+    pub(super) fn path_step(
+        &self,
+        p: &mut Photon,
+        model: &SurfaceModel,
+        surf: &crate::geometry::SurfaceHit,
+        dir: DVec3,
+        rng: &mut PhotonRng,
+    ) -> Option<Feature> {
+        let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
+        let met = Arrival {
+            media: &self.scene.media,
+            hit: surf,
+            dir,
+            medium: p.medium,
+            est: Estimator::Weighted,
+            light: p.light,
+            pol: p.pol,
+            pol_out: &pol_out,
+            shift_out: &shift_out,
+        };
+        let (outcome, feature) = model.interact_on(&met, rng);
+        let Outcome::Scattered {
+            dir,
+            medium,
+            weight,
+        } = outcome
+        else {
+            return None;
+        };
+        p.weight *= weight;
+        let from = surf.point + shift_out.get();
+        p.ray = SpawnedRay::leaving(from, surf.normal, dir, self.scene.spawn_eps);
+        p.medium = medium;
+        if p.pol.is_some() {
+            p.pol = Some(pol_out.get().unwrap_or(Polarization::unpolarized(dir)));
+        }
+        Some(feature)
     }
 
     /// The fraction of light crossing `t` mm of medium `m` unabsorbed and unscattered.

@@ -50,15 +50,13 @@ use super::meter::{Vertex, Walk, in_cone};
 use super::tir_run::{Skipped, TirRun};
 use super::{Photon, Tracer};
 use crate::geometry::{Ray, SpawnedRay};
-use crate::optics::model::{Arrival, MeterLayer};
+use crate::optics::model::MeterLayer;
 use crate::optics::polarization::{Polarization, Stokes, response};
 use crate::optics::spectrum::{Light, Secondaries};
-use crate::optics::surface::{Estimator, Outcome};
 use crate::rng::PhotonRng;
 use crate::tally::MeterHit;
 use crate::tally::meter::{PeelWalk, PeelWalks};
 use glam::DVec3;
-use std::cell::Cell;
 
 /// Events a backward walk takes before it is given up (counted as reaching nothing).
 const WALK_EVENTS: u32 = 256;
@@ -207,49 +205,9 @@ impl Tracer<'_> {
             if !self.crosses(model.meter_layer(), surf.normal) {
                 return None;
             }
-            self.step_back(&mut p, model, &surf, &ray, rng)?;
+            self.path_step(&mut p, model, &surf, ray.dir, rng)?;
         }
         None
-    }
-
-    /// One event of the backward walk at a face it crosses.
-    fn step_back(
-        &self,
-        p: &mut Photon,
-        model: &crate::optics::surface::SurfaceModel,
-        surf: &crate::geometry::SurfaceHit,
-        ray: &Ray,
-        rng: &mut PhotonRng,
-    ) -> Option<()> {
-        let (pol_out, shift_out) = (Cell::new(None), Cell::new(DVec3::ZERO));
-        let met = Arrival {
-            media: &self.scene.media,
-            hit: surf,
-            dir: ray.dir,
-            medium: p.medium,
-            est: Estimator::Weighted,
-            light: p.light,
-            pol: p.pol,
-            pol_out: &pol_out,
-            shift_out: &shift_out,
-        };
-        let (outcome, _) = model.interact_on(&met, rng);
-        let Outcome::Scattered {
-            dir,
-            medium,
-            weight,
-        } = outcome
-        else {
-            return None;
-        };
-        p.weight *= weight;
-        let from = surf.point + shift_out.get();
-        p.ray = SpawnedRay::leaving(from, surf.normal, dir, self.scene.spawn_eps);
-        p.medium = medium;
-        if p.pol.is_some() {
-            p.pol = Some(pol_out.get().unwrap_or(Polarization::unpolarized(dir)));
-        }
-        Some(())
     }
 
     /// The backward walker leaving the target at `start` along unit `dir` in the ambient

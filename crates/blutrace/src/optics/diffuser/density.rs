@@ -14,9 +14,10 @@
 //! first event leaves, which is most of the light at moderate roughness.
 //!
 //! A walk still caught after [`super::MAX_EVENTS`] events is mirrored at the mean plane
-//! by the model (a direction with no density): that light is not in the estimate, and
-//! photons that took that exit are counted in the cone instead (see
-//! [`super::Diffuser::interact`]).
+//! by the model (a direction with no density): that light is not in the estimate, while
+//! the photons that take that exit count as peeled off. It is light of weight at most the
+//! chance of so long a walk: none of 2 million walks reached it at alpha 0.6 or 4 (every
+//! incidence from either side, measured 2026-12-07).
 
 use super::{MAX_EVENTS, sample_visible_normal};
 use crate::optics::fresnel;

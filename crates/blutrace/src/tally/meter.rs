@@ -241,13 +241,22 @@ pub struct PeelWalk {
 /// jackknife holds).
 #[derive(Clone, Debug, Default)]
 pub struct PeelWalks {
-    /// Per `(place, view)` key, the walks drawn so far and how many uses they served.
-    pub lists: std::collections::HashMap<(usize, usize), (Vec<PeelWalk>, u32)>,
+    /// Per `place * views + view`, the walks drawn so far and how many uses they served.
+    lists: Vec<(Vec<PeelWalk>, u32)>,
 }
 
 impl PeelWalks {
     /// Walks a chunk draws per place and view.
     pub const SIZE: usize = 1024;
+
+    /// The walks of key `place * views + view` and their uses so far.
+    pub fn slot(&mut self, key: usize) -> (&mut Vec<PeelWalk>, &mut u32) {
+        if self.lists.len() <= key {
+            self.lists.resize_with(key + 1, Default::default);
+        }
+        let (list, uses) = &mut self.lists[key];
+        (list, uses)
+    }
 }
 
 #[cfg(test)]

@@ -194,7 +194,9 @@ impl Tracer<'_> {
                 tries[1] += u32::from(out.meter.len() > before);
                 if let Outcome::Scattered { dir, medium, .. } = *outcome {
                     (p.covered, p.turned) = (true, u32::MAX);
-                    p.left_with = self.invariant(medium, dir, p.light);
+                    if self.walk == Walk::Flat {
+                        p.left_with = self.invariant(medium, dir, p.light);
+                    }
                 }
             }
             MeterVertex::Unevaluated | MeterVertex::Stochastic => {
@@ -266,7 +268,6 @@ impl Tracer<'_> {
         let normal = d.normal();
         let light = v.at.light;
         let (n_x, n_d) = (self.index(v.at.medium, light), self.index(0, light));
-        let jacobian = d.cone_solid_angle() * (n_d * n_d) / (n_x * n_x);
         for k in 0..d.views.len() {
             let out = in_cone(d.view_dir(k), d.luminance_cone_deg, rng);
             let Some(dirs) = directions_at(out, normal, n_d / n_x) else {
@@ -278,15 +279,34 @@ impl Tracer<'_> {
                     continue;
                 }
                 if let Some((bin, throughput)) = self.peel_path(v.at, dir, out, rng) {
-                    let cosines = out.dot(normal) / dir.dot(normal).abs();
-                    // The hero's wavelength alone: the peel-off path is the hero's (its
-                    // secondaries' own weights are not carried along it).
-                    let w = v.weight * density * throughput * cosines * jacobian;
-                    let spectral = self.scene.sources.spectral().then_some(&Secondaries::NONE);
-                    hits.push(MeterHit::new((k as u16, bin), w, light, spectral));
+                    let w = v.weight * density * throughput;
+                    hits.push(self.meter_hit((k, bin), w, (out, dir), (n_x, light)));
                 }
             }
         }
+    }
+
+    /// The meter's hit of view `k` in flux bin `bin` for light of weight `w` (the photon's
+    /// weight before the event times the event's density and the path's throughput)
+    /// leaving the event along `dir` in a medium of index `n_x` and crossing the target
+    /// along `out`: `w` times the Jacobian from `dir` to `out` over the cone's sampling
+    /// density (module header, step 4).
+    pub(super) fn meter_hit(
+        &self,
+        (k, bin): (usize, u32),
+        w: f64,
+        (out, dir): (DVec3, DVec3),
+        (n_x, light): (f64, Light),
+    ) -> MeterHit {
+        let d = &self.scene.detector;
+        let normal = d.normal();
+        let n_d = self.index(0, light);
+        let jacobian = d.cone_solid_angle() * (n_d * n_d) / (n_x * n_x);
+        let cosines = out.dot(normal) / dir.dot(normal).abs();
+        // The hero's wavelength alone: the peel-off path is the hero's (its secondaries'
+        // own weights are not carried along it).
+        let spectral = self.scene.sources.spectral().then_some(&Secondaries::NONE);
+        MeterHit::new((k as u16, bin), w * cosines * jacobian, light, spectral)
     }
 
     /// Trace the peel-off path leaving the event of `at` along `dir` through specular

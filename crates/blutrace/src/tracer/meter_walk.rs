@@ -95,7 +95,6 @@ impl Tracer<'_> {
         hits: &mut Vec<MeterHit>,
     ) {
         let d = &self.scene.detector;
-        let normal = d.normal();
         for k in 0..d.views.len() {
             let walk = self.pooled_walk(v, k, rng, pool);
             if walk.weight == 0.0 {
@@ -117,13 +116,10 @@ impl Tracer<'_> {
                 continue;
             }
             let light = v.at.light;
-            let (n_x, n_d) = (self.index(walk.medium, light), self.index(0, light));
-            let cosines = walk.out.dot(normal) / walk.dir.dot(normal).abs();
-            let jacobian = d.cone_solid_angle() * (n_d * n_d) / (n_x * n_x) * cosines;
-            let w = v.weight * density * walk.weight * jacobian;
-            let spectral = self.scene.sources.spectral().then_some(&Secondaries::NONE);
+            let n_x = self.index(walk.medium, light);
+            let w = v.weight * density * walk.weight;
             let bin = d.flux_index(ab) as u32;
-            hits.push(MeterHit::new((k as u16, bin), w, light, spectral));
+            hits.push(self.meter_hit((k, bin), w, (walk.out, walk.dir), (n_x, light)));
         }
     }
 
@@ -137,7 +133,7 @@ impl Tracer<'_> {
         rng: &mut PhotonRng,
         pool: &mut PeelWalks,
     ) -> PeelWalk {
-        let (list, uses) = pool.lists.entry((v.start, k)).or_default();
+        let (list, uses) = pool.slot(v.start * self.scene.detector.views.len() + k);
         let i = *uses as usize % PeelWalks::SIZE;
         *uses += 1;
         if i == list.len() {
@@ -155,19 +151,14 @@ impl Tracer<'_> {
         let (a, b) = (0.25 + 0.5 * rng.uniform(), 0.25 + 0.5 * rng.uniform());
         let start = d.origin + d.u * (a * d.size[0]) + d.v * (b * d.size[1]);
         let out = in_cone(d.view_dir(k), d.luminance_cone_deg, rng);
-        let nothing = PeelWalk {
+        self.walk_back(start, out, v, rng).unwrap_or(PeelWalk {
             out,
             shift: DVec3::ZERO,
             dir: out,
             medium: 0,
             weight: 0.0,
             importance: None,
-        };
-        self.walk_back(start, out, v, rng)
-            .map_or(nothing, |end| PeelWalk {
-                shift: start - end.shift,
-                ..end
-            })
+        })
     }
 
     /// The path from the target point `start` along `-out` down to the face of the
@@ -191,10 +182,9 @@ impl Tracer<'_> {
             let super::Hit { surf, struck } = surf?;
             p.weight *= self.transmittance(p.medium, p.light, surf.t);
             if struck.start(scene) == v.start {
-                // `shift` holds the point met until the caller makes it the shift.
                 return Some(PeelWalk {
                     out,
-                    shift: surf.point,
+                    shift: start - surf.point,
                     dir: -ray.dir,
                     medium: p.medium,
                     weight: p.weight,

@@ -163,11 +163,14 @@ impl Tracer<'_> {
                 point: ray.at(h.t),
                 normal: facet.normal,
             };
-            let (light, before, pol_before) = (p.light, p.weight, p.pol);
+            let metered = self.luminance == Some(LuminanceEstimator::Meter);
+            // The state before the event, which the meter's peel-off reads.
+            let pol_before = if metered { p.pol } else { None };
+            let (light, before) = (p.light, p.weight);
             let (outcome, feature, shift) =
                 self.face_step(tag, &surf, (ray.dir, medium, light), &mut p.pol, rng);
             out.ledger.hit(tag, feature != Feature::Plain);
-            if self.luminance == Some(LuminanceEstimator::Meter) {
+            if metered {
                 let model = &scene.surfaces[tag as usize];
                 let event = (before, feature);
                 self.walk_event(
